@@ -1,0 +1,1 @@
+"""Evaluation reports, pictures and USD export (not built yet: issue 5)."""
