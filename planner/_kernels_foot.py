@@ -1,0 +1,637 @@
+"""numba kernels: everything the planner does for one foot (paper §4, §5).
+
+Pipeline for one foot (all arrays are local to a region of interest, ROI, of the
+character's local maps, padded by one ring so neighbour access needs no bounds
+checks):
+
+1. ``prepare_foot``: ROI = bounding box of the source and the candidate disc grown
+   by ``roi_margin_cells``; foot-shape dilation of the forbidden cells ('size
+   increase') and of the elevations; the other legs' projections and the other
+   feet as blocked cells.
+2. ``footprint_candidates``: potential footprints and their scores (§5.1).
+3. ``slice_levels``: elevation slices (§5.2) over the height of obstacles above the
+   terrain, deduplicated (two levels that block the same cells are one slice).
+4. ``search``: the best footprint-trajectory couple (§5.2) with one shared
+   wavefront per slice, 2D scores before 3D ones, the paper's early termination,
+   an exact bound, and the budget (§6).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from planner._grid import cell_centre, cell_of
+from planner._kernels_geometry import segment_point_distance, segments_cross, supercover_visit
+from planner._kernels_wavefront import chamfer_distance, wavefront
+from planner._params import C_CELL, C_MARGIN, C_OBST_MARGIN, C_POT_GAIN, C_POT_RANGE, C_RADIUS, C_SAMPLES, C_SLICE_EPS
+from planner._weights import (
+    N_FOOTPRINT_TERMS,
+    N_TERMS,
+    W_CLEARANCE_REF,
+    W_CLIMB_REF,
+    W_CURVATURE_REF,
+    W_DISTANCE_SCALE,
+    W_JERK_REF,
+    W_LEG_SPACING_REF,
+    W_PROXIMITY_REF,
+    W_SLOPE_CRITICAL,
+    W_STEP_CRITICAL,
+)
+
+# Codes of the per-foot obstacles' map (ROI).
+FREE = 0
+FORBIDDEN = 1  # a forbidden box, or outside the local map
+SIZE_INCREASE = 2  # free, but a foot centred here would touch a forbidden cell
+OTHER_LEG = 3  # another leg's projection or another foot
+PAD = 4  # the padding ring around the ROI
+
+MAX_SLICES = 12
+MAX_DENSE = 1024  # samples of one path; a longer path is refused
+DENSE_SPACING = 0.35  # target spacing of dense samples, in cells
+DENSE_SPACING_MAX = 0.40  # a chord between dense samples may not be longer (cells)
+JERK_SAMPLES = 48
+U_LO = 0.05  # curvature and jerk are evaluated for u in [U_LO, U_HI] (singular at the ends)
+U_HI = 0.95
+
+# Raw trajectory metrics, in this order, in results.
+RAW_LENGTH, RAW_CURVATURE, RAW_CLEARANCE, RAW_CLIMB, RAW_JERK = range(5)
+N_RAW = 5
+# Counters, in this order, in results.
+CNT_COUPLES_3D, CNT_COUPLES_2D, CNT_EXPANDED, CNT_WAVEFRONTS, CNT_CANDIDATES, CNT_SLICES = range(6)
+N_COUNTERS = 6
+
+
+@nb.njit(cache=True)
+def prepare_foot(elevation, ground, forbidden, origin_x, origin_z, cell, offsets, source_x, source_z, pref_x, pref_z,
+                 radius, margin, other_legs, feet_block_radius):
+    """Build the per-foot ROI maps. Returns (code, elev_dil, boxh_dil, elev_raw, r0, c0, hp, wp).
+
+    ``r0, c0`` are the local-map row/col of ROI cell (0, 0); padded flat index of
+    local cell (r, c) is ``(r - r0 + 1) * wp + (c - c0 + 1)``.
+    """
+    n_rows, n_cols = elevation.shape
+    sr, sc = cell_of(source_x, source_z, origin_x, origin_z, cell)
+    pr, pc = cell_of(pref_x, pref_z, origin_x, origin_z, cell)
+    rad = int(math.ceil(radius / cell))
+    r0 = max(0, min(sr, pr - rad) - margin)
+    r1 = min(n_rows - 1, max(sr, pr + rad) + margin)
+    c0 = max(0, min(sc, pc - rad) - margin)
+    c1 = min(n_cols - 1, max(sc, pc + rad) + margin)
+    hp = r1 - r0 + 3
+    wp = c1 - c0 + 3
+    n = hp * wp
+    code = np.full(n, PAD, dtype=np.uint8)
+    elev_dil = np.empty(n, dtype=np.float64)
+    boxh_dil = np.empty(n, dtype=np.float64)
+    elev_raw = np.empty(n, dtype=np.float64)
+    for rr in range(hp):
+        r = r0 - 1 + rr
+        rcl = min(n_rows - 1, max(0, r))
+        for cc in range(wp):
+            c = c0 - 1 + cc
+            ccl = min(n_cols - 1, max(0, c))
+            p = rr * wp + cc
+            emax = -np.inf
+            hmax = 0.0
+            touches_forbidden = False
+            for k in range(offsets.shape[0]):
+                r2 = r + offsets[k, 0]
+                c2 = c + offsets[k, 1]
+                if r2 < 0 or r2 >= n_rows or c2 < 0 or c2 >= n_cols:
+                    touches_forbidden = True
+                    continue
+                e = elevation[r2, c2]
+                if e > emax:
+                    emax = e
+                h = e - ground[r2, c2]
+                if h > hmax:
+                    hmax = h
+                if forbidden[r2, c2]:
+                    touches_forbidden = True
+            elev_raw[p] = elevation[rcl, ccl]
+            elev_dil[p] = emax if emax > -np.inf else elevation[rcl, ccl]
+            boxh_dil[p] = hmax
+            if 1 <= rr < hp - 1 and 1 <= cc < wp - 1:
+                if forbidden[r, c]:
+                    code[p] = FORBIDDEN
+                elif touches_forbidden:
+                    code[p] = SIZE_INCREASE
+                else:
+                    code[p] = FREE
+    # The other legs' projections (4-connected, so no 8-connected path slips across).
+    cap = 4 * (hp + wp) + 8
+    rows = np.empty(cap, dtype=np.int64)
+    cols = np.empty(cap, dtype=np.int64)
+    for j in range(other_legs.shape[0]):
+        m = supercover_visit(other_legs[j, 0], other_legs[j, 1], other_legs[j, 2], other_legs[j, 3],
+                             origin_x, origin_z, cell, rows, cols)
+        for k in range(m):
+            rr = rows[k] - r0 + 1
+            cc = cols[k] - c0 + 1
+            if 1 <= rr < hp - 1 and 1 <= cc < wp - 1:
+                p = rr * wp + cc
+                if code[p] == FREE or code[p] == SIZE_INCREASE:
+                    code[p] = OTHER_LEG
+        # The other foot itself: every cell whose centre is within feet_block_radius.
+        fx = other_legs[j, 2]
+        fz = other_legs[j, 3]
+        fr, fc = cell_of(fx, fz, origin_x, origin_z, cell)
+        reach = int(math.ceil(feet_block_radius / cell)) + 1
+        for dr in range(-reach, reach + 1):
+            for dc in range(-reach, reach + 1):
+                rr = fr + dr - r0 + 1
+                cc = fc + dc - c0 + 1
+                if 1 <= rr < hp - 1 and 1 <= cc < wp - 1:
+                    x, z = cell_centre(fr + dr, fc + dc, origin_x, origin_z, cell)
+                    if math.hypot(x - fx, z - fz) <= feet_block_radius:
+                        p = rr * wp + cc
+                        if code[p] == FREE or code[p] == SIZE_INCREASE:
+                            code[p] = OTHER_LEG
+    return code, elev_dil, boxh_dil, elev_raw, r0, c0, hp, wp
+
+
+@nb.njit(cache=True)
+def footprint_terms(p, x, z, code, elev_dil, elev_raw, prox_dt, wp, pref_x, pref_z, hip_x, hip_z, other_legs, w, cell,
+                    terms):
+    """Fill ``terms[:5]`` with the footprint goodnesses of cell p; False if a leg crossing."""
+    d = math.hypot(x - pref_x, z - pref_z)
+    terms[0] = max(0.0, 1.0 - d / w[W_DISTANCE_SCALE])
+    e = elev_dil[p]
+    rough = 0.0
+    for q in (p - wp - 1, p - wp, p - wp + 1, p - 1, p + 1, p + wp - 1, p + wp, p + wp + 1):
+        rough = max(rough, abs(elev_raw[q] - e))
+    terms[1] = max(0.0, 1.0 - rough / w[W_STEP_CRITICAL])
+    gx = (elev_dil[p + 1] - elev_dil[p - 1]) / (2.0 * cell)
+    gz = (elev_dil[p + wp] - elev_dil[p - wp]) / (2.0 * cell)
+    terms[2] = max(0.0, 1.0 - math.atan(math.hypot(gx, gz)) / w[W_SLOPE_CRITICAL])
+    gap = np.inf
+    for j in range(other_legs.shape[0]):
+        hx = other_legs[j, 0]
+        hz = other_legs[j, 1]
+        fx = other_legs[j, 2]
+        fz = other_legs[j, 3]
+        if segments_cross(hip_x, hip_z, x, z, hx, hz, fx, fz):
+            terms[3] = 0.0
+            terms[4] = 0.0
+            return False
+        gap = min(gap, segment_point_distance(x, z, hx, hz, fx, fz), segment_point_distance(fx, fz, hip_x, hip_z, x, z))
+    terms[3] = min(1.0, gap / w[W_LEG_SPACING_REF])
+    terms[4] = min(1.0, prox_dt[p] / w[W_PROXIMITY_REF])
+    return True
+
+
+@nb.njit(cache=True)
+def weighted_mean(w, terms, lo, hi):
+    num = 0.0
+    den = 0.0
+    for k in range(lo, hi):
+        num += w[k] * terms[k]
+        den += w[k]
+    return num / den if den > 0.0 else 0.0
+
+
+@nb.njit(cache=True)
+def footprint_candidates(code, elev_dil, elev_raw, r0, c0, hp, wp, origin_x, origin_z, cell, source_p, pref_x, pref_z,
+                         radius, hip_x, hip_z, reach_xz, other_legs, w):
+    """Potential footprints (§5.1): free cells in the disc, within reach, no leg crossing.
+
+    Returns (cells, terms (n, 5), scores) sorted by descending footprint score, ties
+    by ascending padded index (deterministic).
+    """
+    n = hp * wp
+    seed = np.zeros(n, dtype=np.uint8)
+    inside = np.zeros(n, dtype=np.uint8)
+    for p in range(n):
+        if code[p] != PAD:
+            inside[p] = 1
+            if code[p] == FORBIDDEN or code[p] == SIZE_INCREASE:
+                seed[p] = 1
+    prox_dt = np.empty(n, dtype=np.float64)
+    chamfer_distance(seed, inside, hp, wp, cell, prox_dt)
+    cells = np.empty(n, dtype=np.int64)
+    terms = np.empty((n, N_FOOTPRINT_TERMS), dtype=np.float64)
+    scores = np.empty(n, dtype=np.float64)
+    buf = np.empty(N_TERMS, dtype=np.float64)
+    m = 0
+    for rr in range(1, hp - 1):
+        for cc in range(1, wp - 1):
+            p = rr * wp + cc
+            if code[p] != FREE or p == source_p:
+                continue
+            x, z = cell_centre(r0 - 1 + rr, c0 - 1 + cc, origin_x, origin_z, cell)
+            if math.hypot(x - pref_x, z - pref_z) > radius:
+                continue
+            if math.hypot(x - hip_x, z - hip_z) > reach_xz:
+                continue
+            if not footprint_terms(p, x, z, code, elev_dil, elev_raw, prox_dt, wp, pref_x, pref_z, hip_x, hip_z,
+                                   other_legs, w, cell, buf):
+                continue
+            cells[m] = p
+            for k in range(N_FOOTPRINT_TERMS):
+                terms[m, k] = buf[k]
+            scores[m] = weighted_mean(w, buf, 0, N_FOOTPRINT_TERMS)
+            m += 1
+    order = np.argsort(-scores[:m], kind="mergesort")
+    return cells[:m][order].copy(), terms[:m][order].copy(), scores[:m][order].copy()
+
+
+@nb.njit(cache=True)
+def slice_levels(code, boxh_dil, slice_size, eps):
+    """Slice levels (m above terrain), first +inf (no slices: go over everything), then
+    descending levels, each blocking strictly more obstacle cells than the previous."""
+    levels = np.empty(MAX_SLICES, dtype=np.float64)
+    levels[0] = np.inf
+    if slice_size <= 0.0:
+        return levels[:1].copy()
+    heights = np.empty(boxh_dil.size, dtype=np.float64)
+    m = 0
+    for p in range(boxh_dil.size):
+        if code[p] != PAD and boxh_dil[p] > eps:
+            heights[m] = boxh_dil[p]
+            m += 1
+    if m == 0:
+        return levels[:1].copy()
+    hs = np.sort(heights[:m])
+    n_levels = 1
+    last_blocked = 0
+    k = int(math.ceil(hs[-1] / slice_size))
+    while k >= 0 and n_levels < MAX_SLICES:
+        level = k * slice_size
+        blocked = m - np.searchsorted(hs, level + eps, side="right")
+        if blocked > last_blocked:
+            levels[n_levels] = level
+            n_levels += 1
+            last_blocked = blocked
+        k -= 1
+    return levels[:n_levels].copy()
+
+
+@nb.njit(cache=True)
+def slice_maps(code, boxh_dil, level, eps, source_p, hp, wp, cell, pot_range, pot_gain, passable, factor, dt):
+    """Passable cells, potential-field cost factors and distance to blocked cells for one slice."""
+    n = hp * wp
+    inside = np.empty(n, dtype=np.uint8)
+    blocked = np.empty(n, dtype=np.uint8)
+    for p in range(n):
+        inside[p] = code[p] != PAD
+        ok = code[p] == FREE and boxh_dil[p] <= level + eps
+        passable[p] = ok or p == source_p
+        blocked[p] = inside[p] and not ok
+    chamfer_distance(blocked, inside, hp, wp, cell, dt)
+    for p in range(n):
+        if pot_range > 0.0 and dt[p] < pot_range:
+            g = 1.0 - dt[p] / pot_range
+            factor[p] = 1.0 + pot_gain * g * g
+        else:
+            factor[p] = 1.0
+
+
+@nb.njit(cache=True)
+def segment_clear(ax, az, bx, bz, passable, source_p, r0, c0, hp, wp, origin_x, origin_z, cell, rows, cols):
+    """Line of sight: every cell the segment touches is passable (or the source cell)."""
+    m = supercover_visit(ax, az, bx, bz, origin_x, origin_z, cell, rows, cols)
+    if m >= rows.size:
+        return False
+    for k in range(m):
+        rr = rows[k] - r0 + 1
+        cc = cols[k] - c0 + 1
+        if rr < 1 or rr >= hp - 1 or cc < 1 or cc >= wp - 1:
+            return False
+        p = rr * wp + cc
+        if p != source_p and not passable[p]:
+            return False
+    return True
+
+
+@nb.njit(cache=True)
+def naive_and_kept_points(parent, source_p, target_p, source_x, source_z, passable, r0, c0, hp, wp, origin_x, origin_z,
+                          cell, rows, cols):
+    """Naive cells of the wavefront path, refined by line of sight (§4).
+
+    Returns the kept points (k, 2) in world x, z: the exact source, the cell
+    centres kept, the target cell centre.
+    """
+    count = 1
+    p = target_p
+    while p != source_p:
+        p = parent[p]
+        count += 1
+    naive = np.empty((count, 2), dtype=np.float64)
+    p = target_p
+    for i in range(count - 1, -1, -1):
+        rr = p // wp
+        cc = p - rr * wp
+        x, z = cell_centre(r0 - 1 + rr, c0 - 1 + cc, origin_x, origin_z, cell)
+        naive[i, 0] = x
+        naive[i, 1] = z
+        if i > 0:
+            p = parent[p]
+    naive[0, 0] = source_x
+    naive[0, 1] = source_z
+    kept_idx = np.empty(count, dtype=np.int64)
+    kept_idx[0] = 0
+    nk = 1
+    i = 0
+    while i < count - 1:
+        j = count - 1
+        while j > i + 1:
+            if segment_clear(naive[i, 0], naive[i, 1], naive[j, 0], naive[j, 1], passable, source_p, r0, c0, hp, wp,
+                             origin_x, origin_z, cell, rows, cols):
+                break
+            j -= 1
+        kept_idx[nk] = j
+        nk += 1
+        i = j
+    kept = np.empty((nk, 2), dtype=np.float64)
+    for k in range(nk):
+        kept[k, 0] = naive[kept_idx[k], 0]
+        kept[k, 1] = naive[kept_idx[k], 1]
+    return kept
+
+
+@nb.njit(cache=True)
+def hermite_dense(kept, tau, cell, dense):
+    """Sample the 2D Hermite curve through the kept points (Catmull-Rom tangents x tau).
+
+    Writes samples into ``dense[:, :2]`` (x, z) and returns how many, or -1 when the
+    curve needs more than MAX_DENSE samples.
+    """
+    nk = kept.shape[0]
+    spacing = DENSE_SPACING * cell
+    n = 0
+    for i in range(nk - 1):
+        p0x = kept[i, 0]
+        p0z = kept[i, 1]
+        p1x = kept[i + 1, 0]
+        p1z = kept[i + 1, 1]
+        if i == 0:
+            t0x = p1x - p0x
+            t0z = p1z - p0z
+        else:
+            t0x = 0.5 * (p1x - kept[i - 1, 0])
+            t0z = 0.5 * (p1z - kept[i - 1, 1])
+        if i == nk - 2:
+            t1x = p1x - p0x
+            t1z = p1z - p0z
+        else:
+            t1x = 0.5 * (kept[i + 2, 0] - p0x)
+            t1z = 0.5 * (kept[i + 2, 1] - p0z)
+        t0x *= tau
+        t0z *= tau
+        t1x *= tau
+        t1z *= tau
+        chord = math.hypot(p1x - p0x, p1z - p0z)
+        est = chord + (math.hypot(t0x, t0z) + math.hypot(t1x, t1z)) / 3.0
+        m = max(1, int(math.ceil(est / spacing)))
+        last = m + 1 if i == nk - 2 else m
+        if n + last > dense.shape[0]:
+            return -1
+        for j in range(last):
+            t = j / m
+            t2 = t * t
+            t3 = t2 * t
+            h00 = 2 * t3 - 3 * t2 + 1
+            h10 = t3 - 2 * t2 + t
+            h01 = -2 * t3 + 3 * t2
+            h11 = t3 - t2
+            dense[n, 0] = h00 * p0x + h10 * t0x + h01 * p1x + h11 * t1x
+            dense[n, 1] = h00 * p0z + h10 * t0z + h01 * p1z + h11 * t1z
+            n += 1
+    dense[n - 1, 0] = kept[nk - 1, 0]
+    dense[n - 1, 1] = kept[nk - 1, 1]
+    return n
+
+
+@nb.njit(cache=True)
+def pchip_slopes(u, y):
+    """Shape-preserving (monotone) cubic Hermite slopes (Fritsch-Carlson / PCHIP)."""
+    n = u.size
+    m = np.zeros(n, dtype=np.float64)
+    if n == 2:
+        s = (y[1] - y[0]) / (u[1] - u[0])
+        m[0] = s
+        m[1] = s
+        return m
+    h = np.empty(n - 1, dtype=np.float64)
+    d = np.empty(n - 1, dtype=np.float64)
+    for i in range(n - 1):
+        h[i] = u[i + 1] - u[i]
+        d[i] = (y[i + 1] - y[i]) / h[i]
+    for i in range(1, n - 1):
+        if d[i - 1] * d[i] > 0.0:
+            w1 = 2 * h[i] + h[i - 1]
+            w2 = h[i] + 2 * h[i - 1]
+            m[i] = (w1 + w2) / (w1 / d[i - 1] + w2 / d[i])
+    for end in range(2):
+        if end == 0:
+            h0, h1, d0, d1 = h[0], h[1], d[0], d[1]
+        else:
+            h0, h1, d0, d1 = h[n - 2], h[n - 3], d[n - 2], d[n - 3]
+        s = ((2 * h0 + h1) * d0 - h0 * d1) / (h0 + h1)
+        if s * d0 <= 0.0:
+            s = 0.0
+        elif d0 * d1 <= 0.0 and abs(s) > abs(3 * d0):
+            s = 3 * d0
+        if end == 0:
+            m[0] = s
+        else:
+            m[n - 1] = s
+    return m
+
+
+@nb.njit(cache=True)
+def resample_by_arclength(poly, n_poly, k, out):
+    """Resample a 3D polyline at k points of constant arc-length spacing. Returns its length."""
+    cum = np.empty(n_poly, dtype=np.float64)
+    cum[0] = 0.0
+    for i in range(1, n_poly):
+        dx = poly[i, 0] - poly[i - 1, 0]
+        dy = poly[i, 1] - poly[i - 1, 1]
+        dz = poly[i, 2] - poly[i - 1, 2]
+        cum[i] = cum[i - 1] + math.sqrt(dx * dx + dy * dy + dz * dz)
+    total = cum[n_poly - 1]
+    j = 0
+    for i in range(k):
+        s = total * i / (k - 1)
+        while j < n_poly - 2 and cum[j + 1] < s:
+            j += 1
+        seg = cum[j + 1] - cum[j]
+        a = (s - cum[j]) / seg if seg > 0.0 else 0.0
+        a = min(1.0, max(0.0, a))
+        for d in range(3):
+            out[i, d] = poly[j, d] + a * (poly[j + 1, d] - poly[j, d])
+    for d in range(3):
+        out[0, d] = poly[0, d]
+        out[k - 1, d] = poly[n_poly - 1, d]
+    return total
+
+
+@nb.njit(cache=True)
+def path_2d(kept, passable, dt, elev_dil, source_p, r0, c0, hp, wp, origin_x, origin_z, cell, dense, dense_p, rows,
+            cols):
+    """2D Hermite path through the kept points, verified chord by chord.
+
+    Tries Catmull-Rom tangents, then halved, then zero tangents (the refined
+    polyline, clear by line of sight). Fills dense[:, :2] and dense_p (ROI index of
+    each sample). Returns (n_dense, length_2d, curvature_energy, clearance_m, max
+    neighbourhood elevation G per sample in dense[:, 2]); n_dense = -1 if none fits.
+    """
+    chord_max = DENSE_SPACING_MAX * cell
+    n = -1
+    for attempt in range(3):
+        tau = 1.0 if attempt == 0 else (0.5 if attempt == 1 else 0.0)
+        n = hermite_dense(kept, tau, cell, dense)
+        if n < 0:
+            continue
+        ok = True
+        for i in range(n):
+            r, c = cell_of(dense[i, 0], dense[i, 1], origin_x, origin_z, cell)
+            rr = r - r0 + 1
+            cc = c - c0 + 1
+            if rr < 1 or rr >= hp - 1 or cc < 1 or cc >= wp - 1:
+                ok = False
+                break
+            dense_p[i] = rr * wp + cc
+            if i > 0:
+                if math.hypot(dense[i, 0] - dense[i - 1, 0], dense[i, 1] - dense[i - 1, 1]) > chord_max:
+                    ok = False
+                    break
+                if not segment_clear(dense[i - 1, 0], dense[i - 1, 1], dense[i, 0], dense[i, 1], passable, source_p,
+                                     r0, c0, hp, wp, origin_x, origin_z, cell, rows, cols):
+                    ok = False
+                    break
+        if ok:
+            break
+        n = -1
+    if n < 2:
+        return -1, 0.0, 0.0, 0.0
+    cum = np.empty(n, dtype=np.float64)
+    cum[0] = 0.0
+    for i in range(1, n):
+        cum[i] = cum[i - 1] + math.hypot(dense[i, 0] - dense[i - 1, 0], dense[i, 1] - dense[i - 1, 1])
+    length = cum[n - 1]
+    # Curvature energy E = L * integral kappa^2 ds, discrete: kappa_i = turning angle / local ds.
+    integral = 0.0
+    clearance = np.inf
+    for i in range(1, n - 1):
+        u = cum[i] / length if length > 0 else 0.0
+        clearance = min(clearance, dt[dense_p[i]])
+        if u < U_LO or u > U_HI:
+            continue
+        ax = dense[i, 0] - dense[i - 1, 0]
+        az = dense[i, 1] - dense[i - 1, 1]
+        bx = dense[i + 1, 0] - dense[i, 0]
+        bz = dense[i + 1, 1] - dense[i, 1]
+        la = math.hypot(ax, az)
+        lb = math.hypot(bx, bz)
+        if la <= 0.0 or lb <= 0.0:
+            continue
+        cross = ax * bz - az * bx
+        dot = ax * bx + az * bz
+        theta = math.atan2(cross, dot)
+        ds = 0.5 * (la + lb)
+        integral += theta * theta / ds
+    if n <= 2:
+        clearance = dt[dense_p[n - 1]]
+    # Highest dilated elevation over the passable cells of the 3 x 3 block of each
+    # sample: every point of a chord between two samples lies in a passable cell
+    # (checked above) of both blocks (chords are shorter than a cell).
+    for i in range(n):
+        p = dense_p[i]
+        g = elev_dil[p]
+        for q in (p - wp - 1, p - wp, p - wp + 1, p - 1, p + 1, p + wp - 1, p + wp, p + wp + 1):
+            if passable[q] or q == source_p:
+                g = max(g, elev_dil[q])
+        dense[i, 2] = g
+    return n, length, length * integral, clearance
+
+
+@nb.njit(cache=True)
+def elevate_3d(dense, n, length2d, source_y, target_y, step_height, margin, cell, poly):
+    """3D trajectory over the 2D path (§4): a shape-preserving cubic Hermite height
+    profile through elevated waypoints, never below the dilated elevation + margin.
+
+    ``dense[:, 2]`` holds G (see ``path_2d``); ``poly`` receives (x, y, z). Returns the
+    highest interior height.
+    """
+    cum = np.empty(n, dtype=np.float64)
+    cum[0] = 0.0
+    for i in range(1, n):
+        cum[i] = cum[i - 1] + math.hypot(dense[i, 0] - dense[i - 1, 0], dense[i, 1] - dense[i - 1, 1])
+    total = cum[n - 1] if cum[n - 1] > 0.0 else 1.0
+    n_wp = min(n, max(3, int(math.ceil(length2d / (2.0 * cell))) + 1)) if n >= 3 else n
+    idx = np.empty(n_wp, dtype=np.int64)
+    for j in range(n_wp):
+        idx[j] = int(round(j * (n - 1) / (n_wp - 1)))
+    wu = np.empty(n_wp, dtype=np.float64)
+    wy = np.empty(n_wp, dtype=np.float64)
+    for j in range(n_wp):
+        u = cum[idx[j]] / total
+        wu[j] = u
+        if j == 0:
+            wy[j] = source_y
+        elif j == n_wp - 1:
+            wy[j] = target_y
+        else:
+            y = source_y + (target_y - source_y) * u + step_height * 4.0 * u * (1.0 - u)
+            lo = max(1, idx[j - 1])
+            hi = min(n - 2, idx[j + 1])
+            for i in range(lo, hi + 1):
+                y = max(y, dense[i, 2] + margin)
+            wy[j] = y
+    slopes = pchip_slopes(wu, wy)
+    seg = 0
+    top = -np.inf
+    for i in range(n):
+        u = cum[i] / total
+        while seg < n_wp - 2 and u > wu[seg + 1]:
+            seg += 1
+        h = wu[seg + 1] - wu[seg]
+        t = (u - wu[seg]) / h if h > 0.0 else 0.0
+        t2 = t * t
+        t3 = t2 * t
+        y = ((2 * t3 - 3 * t2 + 1) * wy[seg] + (t3 - 2 * t2 + t) * h * slopes[seg]
+             + (-2 * t3 + 3 * t2) * wy[seg + 1] + (t3 - t2) * h * slopes[seg + 1])
+        if 0 < i < n - 1:
+            y = max(y, dense[i, 2] + margin)
+            top = max(top, y)
+        poly[i, 0] = dense[i, 0]
+        poly[i, 1] = y
+        poly[i, 2] = dense[i, 1]
+    poly[0, 1] = source_y
+    poly[n - 1, 1] = target_y
+    return top
+
+
+@nb.njit(cache=True)
+def geometric_jerk(poly, n, work):
+    """J = L^3 * integral |d^3x/ds^3|^2 ds over u in [U_LO, U_HI] (scale free)."""
+    length = resample_by_arclength(poly, n, JERK_SAMPLES, work)
+    if length <= 0.0:
+        return 0.0
+    h = length / (JERK_SAMPLES - 1)
+    acc = 0.0
+    for k in range(1, JERK_SAMPLES - 2):
+        u = k / (JERK_SAMPLES - 1)
+        if u < U_LO or u > U_HI:
+            continue
+        s = 0.0
+        for d in range(3):
+            j3 = (work[k + 2, d] - 3.0 * work[k + 1, d] + 3.0 * work[k, d] - work[k - 1, d]) / (h * h * h)
+            s += j3 * j3
+        acc += s * h
+    return length ** 3 * acc
+
+
+@nb.njit(cache=True)
+def path_length_3d(poly, n):
+    total = 0.0
+    for i in range(1, n):
+        dx = poly[i, 0] - poly[i - 1, 0]
+        dy = poly[i, 1] - poly[i - 1, 1]
+        dz = poly[i, 2] - poly[i - 1, 2]
+        total += math.sqrt(dx * dx + dy * dy + dz * dz)
+    return total

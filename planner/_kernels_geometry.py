@@ -1,0 +1,189 @@
+"""numba kernels: rasterising boxes, feet and leg segments onto grids.
+
+All kernels take the grid placement as (origin_x, origin_z, cell) with the
+convention of :mod:`planner._grid` (rows along z, columns along x).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+
+@nb.njit(cache=True)
+def rect_overlaps_aabb(cx, cz, hx, hz, yaw, ax, az, ahx, ahz):
+    """Separating-axis test: oriented rectangle vs axis-aligned box in the x/z plane.
+
+    The rectangle has centre (cx, cz), half extents (hx, hz) along its local axes
+    u = (cos yaw, sin yaw) and v = (-sin yaw, cos yaw). The AABB has centre (ax, az)
+    and half extents (ahx, ahz). Touching counts as overlapping (conservative).
+    """
+    cs = math.cos(yaw)
+    sn = math.sin(yaw)
+    acs = abs(cs)
+    asn = abs(sn)
+    dx = ax - cx
+    dz = az - cz
+    if abs(dx) > ahx + hx * acs + hz * asn:
+        return False
+    if abs(dz) > ahz + hx * asn + hz * acs:
+        return False
+    if abs(dx * cs + dz * sn) > hx + ahx * acs + ahz * asn:
+        return False
+    if abs(-dx * sn + dz * cs) > hz + ahx * asn + ahz * acs:
+        return False
+    return True
+
+
+@nb.njit(cache=True)
+def rasterise_boxes(top, forbidden, origin_x, origin_z, cell, centres, sizes, yaws, box_forbidden, selected):
+    """Voxelise boxes onto a grid: raise ``top`` to each box's top and flag forbidden cells.
+
+    A cell is covered when its square overlaps the box's footprint (conservative,
+    rotated boxes included). Only boxes with ``selected[i]`` are drawn.
+    """
+    n_rows, n_cols = top.shape
+    half = 0.5 * cell
+    for i in range(centres.shape[0]):
+        if not selected[i]:
+            continue
+        cx = centres[i, 0]
+        cz = centres[i, 2]
+        hx = 0.5 * sizes[i, 0]
+        hz = 0.5 * sizes[i, 2]
+        yaw = yaws[i]
+        box_top = centres[i, 1] + 0.5 * sizes[i, 1]
+        ex = hx * abs(math.cos(yaw)) + hz * abs(math.sin(yaw))
+        ez = hx * abs(math.sin(yaw)) + hz * abs(math.cos(yaw))
+        c0 = max(0, int(math.floor((cx - ex - origin_x) / cell)) - 1)
+        c1 = min(n_cols - 1, int(math.floor((cx + ex - origin_x) / cell)) + 1)
+        r0 = max(0, int(math.floor((cz - ez - origin_z) / cell)) - 1)
+        r1 = min(n_rows - 1, int(math.floor((cz + ez - origin_z) / cell)) + 1)
+        for r in range(r0, r1 + 1):
+            az = origin_z + (r + 0.5) * cell
+            for c in range(c0, c1 + 1):
+                ax = origin_x + (c + 0.5) * cell
+                if rect_overlaps_aabb(cx, cz, hx, hz, yaw, ax, az, half, half):
+                    if box_top > top[r, c]:
+                        top[r, c] = box_top
+                    if box_forbidden[i]:
+                        forbidden[r, c] = 1
+
+
+@nb.njit(cache=True)
+def foot_offsets(foot_length, foot_width, foot_yaw, cell):
+    """Cell offsets (d_row, d_col) of the 'size increase' stencil of a foot (paper Fig. 12).
+
+    A foot centred anywhere in cell C overlaps an obstacle only if some forbidden cell
+    lies at C + offset for an offset here: the offsets are the cells whose square,
+    grown by half a cell, overlaps the foot rectangle (length along ``foot_yaw``).
+    The stencil always contains the 3 x 3 block around the origin.
+    """
+    hx = 0.5 * foot_length
+    hz = 0.5 * foot_width
+    reach = int(math.ceil((math.hypot(hx, hz)) / cell)) + 1
+    out = np.empty(((2 * reach + 1) ** 2, 2), dtype=np.int64)
+    n = 0
+    for dr in range(-reach, reach + 1):
+        for dc in range(-reach, reach + 1):
+            if rect_overlaps_aabb(0.0, 0.0, hx, hz, foot_yaw, dc * cell, dr * cell, cell, cell):
+                out[n, 0] = dr
+                out[n, 1] = dc
+                n += 1
+    return out[:n].copy()
+
+
+@nb.njit(cache=True)
+def supercover_visit(ax, az, bx, bz, origin_x, origin_z, cell, rows_out, cols_out):
+    """Cells touched by segment a->b (every cell it passes through, corners included).
+
+    Writes up to ``rows_out.size`` cells and returns how many were written. A segment
+    through a cell corner marks both side cells, so the cells form a 4-connected chain
+    that no 8-connected path can slip across.
+    """
+    u0 = (ax - origin_x) / cell
+    v0 = (az - origin_z) / cell
+    u1 = (bx - origin_x) / cell
+    v1 = (bz - origin_z) / cell
+    c = int(math.floor(u0))
+    r = int(math.floor(v0))
+    c_end = int(math.floor(u1))
+    r_end = int(math.floor(v1))
+    du = u1 - u0
+    dv = v1 - v0
+    step_c = 1 if du > 0 else -1
+    step_r = 1 if dv > 0 else -1
+    inf = 1e300
+    if du != 0.0:
+        t_max_c = ((c + (1 if du > 0 else 0)) - u0) / du
+        t_delta_c = abs(1.0 / du)
+    else:
+        t_max_c = inf
+        t_delta_c = inf
+    if dv != 0.0:
+        t_max_r = ((r + (1 if dv > 0 else 0)) - v0) / dv
+        t_delta_r = abs(1.0 / dv)
+    else:
+        t_max_r = inf
+        t_delta_r = inf
+    cap = rows_out.size
+    n = 0
+    rows_out[n] = r
+    cols_out[n] = c
+    n += 1
+    guard = abs(c_end - c) + abs(r_end - r) + 2
+    for _ in range(2 * guard):
+        if r == r_end and c == c_end:
+            break
+        if t_max_c > 1.0 and t_max_r > 1.0:
+            break
+        if abs(t_max_c - t_max_r) < 1e-9:
+            # Through a corner: both side cells are touched.
+            if n + 2 <= cap:
+                rows_out[n] = r + step_r
+                cols_out[n] = c
+                rows_out[n + 1] = r
+                cols_out[n + 1] = c + step_c
+                n += 2
+            r += step_r
+            c += step_c
+            t_max_c += t_delta_c
+            t_max_r += t_delta_r
+        elif t_max_c < t_max_r:
+            c += step_c
+            t_max_c += t_delta_c
+        else:
+            r += step_r
+            t_max_r += t_delta_r
+        if n < cap:
+            rows_out[n] = r
+            cols_out[n] = c
+            n += 1
+    return n
+
+
+@nb.njit(cache=True)
+def segment_point_distance(px, pz, ax, az, bx, bz):
+    """Distance from point p to segment a-b in the plane."""
+    dx = bx - ax
+    dz = bz - az
+    ll = dx * dx + dz * dz
+    t = 0.0
+    if ll > 0.0:
+        t = ((px - ax) * dx + (pz - az) * dz) / ll
+        t = min(1.0, max(0.0, t))
+    ex = ax + t * dx - px
+    ez = az + t * dz - pz
+    return math.sqrt(ex * ex + ez * ez)
+
+
+@nb.njit(cache=True)
+def segments_cross(ax, az, bx, bz, cx, cz, dx, dz):
+    """True when segments a-b and c-d properly intersect (shared endpoints excluded)."""
+    d1 = (bx - ax) * (cz - az) - (bz - az) * (cx - ax)
+    d2 = (bx - ax) * (dz - az) - (bz - az) * (dx - ax)
+    d3 = (dx - cx) * (az - cz) - (dz - cz) * (ax - cx)
+    d4 = (dx - cx) * (bz - cz) - (dz - cz) * (bx - cx)
+    return (d1 * d2 < 0.0) and (d3 * d4 < 0.0)

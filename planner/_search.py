@@ -1,0 +1,165 @@
+"""Thin Python API over the planner kernels: validate and cast, call, wrap."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from planner._kernels_foot import N_COUNTERS, N_RAW
+from planner._kernels_geometry import foot_offsets
+from planner._kernels_search import MODE_BRUTE_FORCE, MODE_PER_TARGET, MODE_SEARCH, plan_foot_kernel
+from planner._kernels_wavefront import wavefront
+from planner._maps import LocalMaps
+from planner._params import DEFAULT_BUDGET, PlannerConfig, SearchBudget
+from planner._weights import SCORE_TERMS, ScoringWeights
+
+RAW_METRICS = ("length_m", "curvature_energy", "clearance_m", "climb_m", "jerk")
+COUNTERS = ("couples_evaluated", "couples_2d", "cells_expanded", "wavefronts", "candidates", "slices")
+assert len(RAW_METRICS) == N_RAW and len(COUNTERS) == N_COUNTERS
+MODES = {"search": MODE_SEARCH, "per_target": MODE_PER_TARGET, "brute_force": MODE_BRUTE_FORCE}
+
+
+def _vec(name: str, value, n: int) -> np.ndarray:
+    a = np.asarray(value, dtype=np.float64).reshape(-1)
+    if a.shape != (n,) or not np.isfinite(a).all():
+        raise ValueError(f"{name}: expected {n} finite numbers, got {value!r}")
+    return a
+
+
+@dataclass(frozen=True)
+class FootQuery:
+    """What the planner needs to know about one foot (world coordinates, metres).
+
+    source:       (x, y, z) where the foot is now.
+    preferred:    (x, z) preferred footprint from the character controller.
+    hip:          (x, z) of this leg's hip (for reach and crossings).
+    reach_xz:     horizontal reach of the leg from its hip.
+    step_height:  preferred step height of the swing.
+    foot_length, foot_width, foot_yaw: the foot rectangle (length along foot_yaw,
+                  radians, world yaw convention (cos, sin) in (x, z)).
+    other_legs:   (M, 4) rows (hip_x, hip_z, foot_x, foot_z) of the other legs.
+    """
+
+    source: np.ndarray
+    preferred: np.ndarray
+    hip: np.ndarray
+    reach_xz: float
+    step_height: float
+    foot_length: float
+    foot_width: float
+    foot_yaw: float
+    other_legs: np.ndarray = field(default_factory=lambda: np.zeros((0, 4)))
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "source", _vec("FootQuery.source", self.source, 3))
+        object.__setattr__(self, "preferred", _vec("FootQuery.preferred", self.preferred, 2))
+        object.__setattr__(self, "hip", _vec("FootQuery.hip", self.hip, 2))
+        legs = np.ascontiguousarray(np.asarray(self.other_legs, dtype=np.float64).reshape(-1, 4))
+        if not np.isfinite(legs).all():
+            raise ValueError("FootQuery.other_legs: must be finite")
+        object.__setattr__(self, "other_legs", legs)
+        for name in ("reach_xz", "foot_length", "foot_width"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+                raise ValueError(f"FootQuery.{name}: expected a positive number of metres, got {v!r}")
+        for name in ("step_height", "foot_yaw"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v)):
+                raise ValueError(f"FootQuery.{name}: expected a finite number, got {v!r}")
+
+    @property
+    def feet_block_radius(self) -> float:
+        """Other feet block cells within two foot half-diagonals (feet never overlap)."""
+        return float(math.hypot(self.foot_length, self.foot_width))
+
+
+@dataclass(frozen=True)
+class CoupleResult:
+    """The chosen footprint-trajectory couple, with its per-criterion breakdown.
+
+    ``valid`` False means no couple exists: the foot holds (``target`` = source and
+    ``trajectory`` repeats it).
+    """
+
+    valid: bool
+    target_cell: tuple[int, int]
+    target: np.ndarray  # (3,) world
+    slice_index: int
+    slice_level_m: float  # height above terrain of the slice (inf = no slices: go over)
+    couple_score: float
+    footprint_score: float
+    trajectory_score: float
+    breakdown: dict[str, float]  # goodness in [0, 1] per criterion (SCORE_TERMS)
+    metrics: dict[str, float]  # raw trajectory metrics (RAW_METRICS)
+    counters: dict[str, int]
+    trajectory: np.ndarray  # (K, 3) samples at constant arc length, source -> target
+    candidate_cells: np.ndarray  # (n, 2) local (row, col), descending footprint score
+    candidate_scores: np.ndarray  # (n,)
+
+
+def plan_foot(maps: LocalMaps, query: FootQuery, weights: ScoringWeights | None = None,
+              budget: SearchBudget = DEFAULT_BUDGET, config: PlannerConfig | None = None,
+              mode: str = "search") -> CoupleResult:
+    """Best footprint-trajectory couple for one foot (paper §5.2). Never raises for a
+    boxed-in foot: the result is then ``valid=False``."""
+    weights = weights or ScoringWeights()
+    config = config or PlannerConfig()
+    if mode not in MODES:
+        raise ValueError(f"mode: expected one of {sorted(MODES)}, got {mode!r}")
+    if abs(maps.frame.cell_size - config.cell_size) > 1e-12:
+        raise ValueError(f"maps: cell size {maps.frame.cell_size} differs from config.cell_size {config.cell_size}")
+    r, c = maps.frame.world_to_cell(query.source[0], query.source[2])
+    if not maps.frame.contains_cell(r, c):
+        raise ValueError("query.source: outside the local maps")
+    offsets = foot_offsets(query.foot_length, query.foot_width, query.foot_yaw, config.cell_size)
+    couples_after_first, slice_size, early = budget.kernel_args()
+    out = plan_foot_kernel(
+        maps.elevation, maps.ground, maps.forbidden, maps.frame.origin_x, maps.frame.origin_z, offsets,
+        query.source, query.preferred, query.hip, float(query.reach_xz), float(query.step_height),
+        query.other_legs, query.feet_block_radius, weights.to_array(), config.to_array(),
+        couples_after_first, slice_size, early, MODES[mode])
+    valid, target_rc, target, s_idx, level, scores, terms, raw, counters, traj, cand_rc, cand_scores = out
+    return CoupleResult(
+        valid=bool(valid), target_cell=(int(target_rc[0]), int(target_rc[1])), target=target,
+        slice_index=int(s_idx), slice_level_m=float(level), couple_score=float(scores[0]),
+        footprint_score=float(scores[1]), trajectory_score=float(scores[2]),
+        breakdown=dict(zip(SCORE_TERMS, map(float, terms))), metrics=dict(zip(RAW_METRICS, map(float, raw))),
+        counters=dict(zip(COUNTERS, map(int, counters))), trajectory=traj, candidate_cells=cand_rc,
+        candidate_scores=cand_scores)
+
+
+def wavefront_distances(passable, source: tuple[int, int], cell_size: float = 1.0, cost_factor=None,
+                        targets=None) -> np.ndarray:
+    """Wavefront (8-connected, no corner cutting) costs from ``source`` over a boolean grid.
+
+    ``cost_factor`` (same shape, >= 1) multiplies the cost of entering a cell (the
+    potential field); unreached cells are inf. With ``targets`` ((k, 2) cells) the
+    wavefront stops once they are all settled; otherwise it covers the grid.
+    """
+    passable = np.asarray(passable, dtype=bool)
+    if passable.ndim != 2:
+        raise ValueError(f"passable: expected a 2-D grid, got shape {passable.shape}")
+    h, w = passable.shape
+    sr, sc = source
+    if not (0 <= sr < h and 0 <= sc < w):
+        raise ValueError(f"source: {source} is outside the {h} x {w} grid")
+    wp = w + 2
+    flat_pass = np.zeros((h + 2, wp), dtype=np.uint8)
+    flat_pass[1:-1, 1:-1] = passable
+    factor = np.ones((h + 2, wp), dtype=np.float64)
+    if cost_factor is not None:
+        cf = np.asarray(cost_factor, dtype=np.float64)
+        if cf.shape != passable.shape or not np.isfinite(cf).all() or (cf <= 0).any():
+            raise ValueError("cost_factor: expected positive finite numbers with the shape of passable")
+        factor[1:-1, 1:-1] = cf
+    if targets is None:
+        stop = np.array([(r + 1) * wp + c + 1 for r in range(h) for c in range(w) if passable[r, c]], dtype=np.int64)
+    else:
+        t = np.asarray(targets, dtype=np.int64).reshape(-1, 2)
+        stop = (t[:, 0] + 1) * wp + t[:, 1] + 1
+    dist = np.empty((h + 2) * wp)
+    parent = np.empty((h + 2) * wp, dtype=np.int64)
+    wavefront(flat_pass.ravel(), factor.ravel(), wp, (sr + 1) * wp + sc + 1, float(cell_size), stop, dist, parent)
+    return dist.reshape(h + 2, wp)[1:-1, 1:-1].copy()

@@ -1,0 +1,135 @@
+"""The scoring weights: one typed, validated, frozen definition.
+
+Every footprint criterion and every trajectory criterion is turned into a
+*goodness* in [0, 1] (1 = best), and scores are weighted means of goodnesses:
+
+* footprint score  = sum_k w_k s_k / sum_k w_k over the five footprint terms
+  (paper §5.1: "normalised between 0 and 1");
+* couple score     = weighted mean over all ten terms (footprint and trajectory),
+  so a couple score is also in [0, 1] and comparable between feet.
+
+The numba runtime (:mod:`planner._kernels_score`) and the JAX proxies (tuning/)
+read the same fields in the same order through :meth:`ScoringWeights.to_array`;
+the index constants below are that order.
+
+Tuning guide
+------------
+* Raise ``footprint_distance`` to make feet land on the preferred footprint
+  (tight, regular gait); lower it to let them wander to flatter, safer ground.
+* ``footprint_elevation`` / ``footprint_slope`` trade regularity for flat footholds;
+  ``step_critical_m`` and ``slope_critical_rad`` are the heights / angles at which a
+  foothold is worth nothing (defaults from Wermelinger et al. 2016).
+* ``trajectory_length`` vs ``trajectory_climb`` decides between going *around* an
+  obstacle (longer path) and going *over* it (climb); with slices the planner
+  tries both and these two weights arbitrate.
+* ``trajectory_curvature`` prefers straight, direct swings (curvature energy is
+  scale free: an arc turning by theta costs theta^2).
+* Reference scales (``*_ref``) set where a goodness reaches 1/2 (rational terms) or
+  0 (linear terms); change them with the creature's size.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+def _w(doc: str, default: float, *, unit: str = "-", scale: bool = False):
+    return field(default=default, metadata={"doc": doc, "unit": unit, "scale": scale})
+
+
+@dataclass(frozen=True)
+class ScoringWeights:
+    """Weights (dimensionless, >= 0) and reference scales (> 0, units per field)."""
+
+    # -- footprint terms (paper §5.1) -------------------------------------------------
+    footprint_distance: float = _w("closeness to the preferred footprint: s = max(0, 1 - d / distance_scale_m)", 3.0)
+    footprint_elevation: float = _w(
+        "flatness with the surrounding cells: s = max(0, 1 - max|dh| / step_critical_m) over the 8 neighbours", 1.0
+    )
+    footprint_slope: float = _w("low slope: s = max(0, 1 - angle / slope_critical_rad)", 1.0)
+    footprint_leg_spacing: float = _w(
+        "room to the other legs: s = min(1, gap / leg_spacing_ref_m); a crossing is refused outright", 1.0
+    )
+    footprint_obstacle_proximity: float = _w("distance to forbidden cells: s = min(1, d / proximity_ref_m)", 1.0)
+    # -- trajectory terms (paper §5.2, 'trajectory scoring') -----------------------------
+    trajectory_length: float = _w("short path: s = d_ref / max(length, d_ref), d_ref = source->preferred distance", 2.0)
+    trajectory_curvature: float = _w(
+        "straight path: s = 1 / (1 + E / curvature_energy_ref), E = length * integral kappa^2 ds (horizontal)", 1.0
+    )
+    trajectory_clearance: float = _w("horizontal margin to blocked cells: s = min(1, d_min / clearance_ref_m)", 0.5)
+    trajectory_climb: float = _w(
+        "little rise beyond the step height: s = 1 / (1 + climb / climb_ref_m)", 1.0
+    )
+    trajectory_jerk: float = _w("smooth 3D motion: s = 1 / (1 + J / jerk_ref), J = length^3 integral |x'''(s)|^2 ds", 0.5)
+    # -- reference scales -----------------------------------------------------------------
+    distance_scale_m: float = _w("distance to the preferred footprint at which closeness is worth 0", 0.30, unit="m", scale=True)
+    step_critical_m: float = _w("height step to a neighbour cell at which flatness is worth 0", 0.12, unit="m", scale=True)
+    slope_critical_rad: float = _w("slope at which a foothold is worth 0", 1.0, unit="rad", scale=True)
+    leg_spacing_ref_m: float = _w("gap to the other legs that counts as enough room", 0.05, unit="m", scale=True)
+    proximity_ref_m: float = _w("distance to a forbidden cell that counts as safe", 0.10, unit="m", scale=True)
+    curvature_energy_ref: float = _w("curvature energy worth 1/2", 1.0, scale=True)
+    clearance_ref_m: float = _w("horizontal path margin that counts as safe", 0.07, unit="m", scale=True)
+    climb_ref_m: float = _w("extra rise worth 1/2", 0.10, unit="m", scale=True)
+    jerk_ref: float = _w("normalised geometric jerk worth 1/2", 2000.0, scale=True)
+
+    def __post_init__(self) -> None:
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+                raise ValueError(f"ScoringWeights.{f.name}: expected a number, got {type(value).__name__}")
+            value = float(value)
+            object.__setattr__(self, f.name, value)
+            if not math.isfinite(value):
+                raise ValueError(f"ScoringWeights.{f.name}: must be finite, got {value!r}")
+            if f.metadata["scale"] and value <= 0:
+                raise ValueError(f"ScoringWeights.{f.name}: a reference scale must be > 0, got {value!r}")
+            if not f.metadata["scale"] and value < 0:
+                raise ValueError(f"ScoringWeights.{f.name}: a weight must be >= 0, got {value!r}")
+        if sum(getattr(self, n) for n in FOOTPRINT_WEIGHT_FIELDS) <= 0:
+            raise ValueError("ScoringWeights: at least one footprint weight must be > 0")
+
+    # -- array round trip ------------------------------------------------------------------
+    def to_array(self) -> np.ndarray:
+        """float64 array in :data:`WEIGHT_FIELDS` order (lossless)."""
+        return np.array([getattr(self, n) for n in WEIGHT_FIELDS], dtype=np.float64)
+
+    @classmethod
+    def from_array(cls, values) -> "ScoringWeights":
+        values = np.asarray(values, dtype=np.float64)
+        if values.shape != (len(WEIGHT_FIELDS),):
+            raise ValueError(f"ScoringWeights.from_array: expected shape ({len(WEIGHT_FIELDS)},), got {values.shape}")
+        return cls(**{n: float(v) for n, v in zip(WEIGHT_FIELDS, values)})
+
+    def to_dict(self) -> dict[str, float]:
+        return {n: getattr(self, n) for n in WEIGHT_FIELDS}
+
+    @classmethod
+    def describe(cls) -> list[tuple[str, str, str]]:
+        """(name, unit, meaning) of every field, in array order."""
+        return [(f.name, f.metadata["unit"], f.metadata["doc"]) for f in dataclasses.fields(cls)]
+
+
+WEIGHT_FIELDS: tuple[str, ...] = tuple(f.name for f in dataclasses.fields(ScoringWeights))
+FOOTPRINT_TERMS: tuple[str, ...] = ("distance", "elevation", "slope", "leg_spacing", "obstacle_proximity")
+TRAJECTORY_TERMS: tuple[str, ...] = ("length", "curvature", "clearance", "climb", "jerk")
+SCORE_TERMS: tuple[str, ...] = FOOTPRINT_TERMS + TRAJECTORY_TERMS
+FOOTPRINT_WEIGHT_FIELDS = tuple("footprint_" + t for t in FOOTPRINT_TERMS)
+TRAJECTORY_WEIGHT_FIELDS = tuple("trajectory_" + t for t in TRAJECTORY_TERMS)
+
+# Index constants into ScoringWeights.to_array(), used by the numba kernels and the JAX proxies.
+N_FOOTPRINT_TERMS = len(FOOTPRINT_TERMS)
+N_TERMS = len(SCORE_TERMS)
+W_DISTANCE_SCALE = WEIGHT_FIELDS.index("distance_scale_m")
+W_STEP_CRITICAL = WEIGHT_FIELDS.index("step_critical_m")
+W_SLOPE_CRITICAL = WEIGHT_FIELDS.index("slope_critical_rad")
+W_LEG_SPACING_REF = WEIGHT_FIELDS.index("leg_spacing_ref_m")
+W_PROXIMITY_REF = WEIGHT_FIELDS.index("proximity_ref_m")
+W_CURVATURE_REF = WEIGHT_FIELDS.index("curvature_energy_ref")
+W_CLEARANCE_REF = WEIGHT_FIELDS.index("clearance_ref_m")
+W_CLIMB_REF = WEIGHT_FIELDS.index("climb_ref_m")
+W_JERK_REF = WEIGHT_FIELDS.index("jerk_ref")
+assert WEIGHT_FIELDS[:N_TERMS] == FOOTPRINT_WEIGHT_FIELDS + TRAJECTORY_WEIGHT_FIELDS

@@ -1,0 +1,74 @@
+"""Rasterisation kernels on cases small enough to check by hand."""
+
+import math
+
+import numpy as np
+
+from planner._kernels_geometry import foot_offsets, rasterise_boxes, segments_cross, supercover_visit
+
+
+def _cells(ax, az, bx, bz, cell=1.0):
+    rows = np.empty(64, np.int64)
+    cols = np.empty(64, np.int64)
+    n = supercover_visit(ax, az, bx, bz, 0.0, 0.0, cell, rows, cols)
+    return sorted(zip(rows[:n].tolist(), cols[:n].tolist()))
+
+
+def test_supercover_of_a_row_segment():
+    assert _cells(0.5, 0.5, 3.5, 0.5) == [(0, 0), (0, 1), (0, 2), (0, 3)]
+
+
+def test_supercover_through_corners_marks_both_side_cells():
+    # Diagonal through the corners of cells: the side cells are touched too.
+    assert _cells(0.5, 0.5, 2.5, 2.5) == [(0, 0), (0, 1), (1, 0), (1, 1), (1, 2), (2, 1), (2, 2)]
+
+
+def test_supercover_of_a_shallow_segment_is_4_connected():
+    cells = _cells(0.2, 0.3, 4.7, 1.6)
+    s = set(cells)
+    # every cell except the last has a 4-neighbour in the set
+    assert all(any((r + dr, c + dc) in s for dr, dc in ((0, 1), (1, 0), (0, -1), (-1, 0))) for r, c in cells)
+    assert (0, 0) in s and (1, 4) in s
+
+
+def test_small_foot_stencil_is_the_3x3_block():
+    off = foot_offsets(0.03, 0.02, 0.4, 0.07)
+    assert sorted(map(tuple, off.tolist())) == [(dr, dc) for dr in (-1, 0, 1) for dc in (-1, 0, 1)]
+
+
+def test_long_foot_stencil_follows_its_orientation():
+    along_x = {tuple(o) for o in foot_offsets(0.30, 0.02, 0.0, 0.07).tolist()}
+    along_z = {tuple(o) for o in foot_offsets(0.30, 0.02, math.pi / 2, 0.07).tolist()}
+    assert (0, 3) in along_x and (3, 0) not in along_x
+    assert (3, 0) in along_z and (0, 3) not in along_z
+
+
+def test_rotated_box_rasterisation():
+    # A 2 x 0.2 box rotated 45 degrees, centred at (2.5, 2.5) on a 5 x 5 grid of 1 m cells:
+    # it covers the cells of the diagonal and (being conservative) their corner neighbours.
+    top = np.zeros((5, 5))
+    forbidden = np.zeros((5, 5), np.uint8)
+    rasterise_boxes(top, forbidden, 0.0, 0.0, 1.0, np.array([[2.5, 0.5, 2.5]]), np.array([[2.0, 1.0, 0.2]]),
+                    np.array([math.pi / 4]), np.array([True]), np.array([True]))
+    expected = np.zeros((5, 5), np.uint8)
+    for r, c in [(1, 1), (1, 2), (2, 1), (2, 2), (2, 3), (3, 2), (3, 3)]:
+        expected[r, c] = 1
+    np.testing.assert_array_equal(forbidden, expected)
+    np.testing.assert_array_equal(top, expected * 1.0)
+
+
+def test_safe_box_raises_elevation_without_forbidding():
+    top = np.full((3, 3), 0.1)
+    forbidden = np.zeros((3, 3), np.uint8)
+    rasterise_boxes(top, forbidden, 0.0, 0.0, 1.0, np.array([[1.5, 0.2, 1.5]]), np.array([[0.5, 0.4, 0.5]]),
+                    np.array([0.0]), np.array([False]), np.array([True]))
+    expected = np.full((3, 3), 0.1)
+    expected[1, 1] = 0.4
+    np.testing.assert_array_equal(top, expected)
+    assert not forbidden.any()
+
+
+def test_segments_cross():
+    assert segments_cross(0, 0, 2, 2, 0, 2, 2, 0)
+    assert not segments_cross(0, 0, 1, 1, 2, 2, 3, 3)
+    assert not segments_cross(0, 0, 2, 0, 0, 1, 2, 1)

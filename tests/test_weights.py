@@ -1,0 +1,67 @@
+import dataclasses
+
+import numpy as np
+import pytest
+
+from planner import WEIGHT_FIELDS, PlannerConfig, ScoringWeights, SearchBudget
+
+
+def test_array_round_trip_is_lossless():
+    rng = np.random.default_rng(0)
+    for _ in range(100):
+        values = rng.uniform(0.001, 10.0, size=len(WEIGHT_FIELDS))
+        w = ScoringWeights.from_array(values)
+        np.testing.assert_array_equal(w.to_array(), values)
+        assert ScoringWeights.from_array(w.to_array()) == w
+
+
+def test_field_order_is_the_array_order_and_documented():
+    w = ScoringWeights()
+    assert tuple(f.name for f in dataclasses.fields(w)) == WEIGHT_FIELDS
+    for name, unit, doc in ScoringWeights.describe():
+        assert unit and doc, name
+    assert w.to_array()[WEIGHT_FIELDS.index("slope_critical_rad")] == w.slope_critical_rad
+
+
+def test_weights_are_frozen():
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        ScoringWeights().footprint_distance = 2.0
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"footprint_slope": -1.0}, "footprint_slope"),
+        ({"jerk_ref": 0.0}, "jerk_ref"),
+        ({"climb_ref_m": float("nan")}, "climb_ref_m"),
+        ({"trajectory_length": "big"}, "trajectory_length"),
+        (
+            {
+                "footprint_distance": 0.0,
+                "footprint_elevation": 0.0,
+                "footprint_slope": 0.0,
+                "footprint_leg_spacing": 0.0,
+                "footprint_obstacle_proximity": 0.0,
+            },
+            "footprint weight",
+        ),
+    ],
+)
+def test_invalid_weights_are_refused_naming_the_field(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        ScoringWeights(**kwargs)
+
+
+def test_from_array_checks_the_shape():
+    with pytest.raises(ValueError, match="shape"):
+        ScoringWeights.from_array(np.ones(3))
+
+
+def test_budget_and_config_validation():
+    with pytest.raises(ValueError, match="couples_after_first"):
+        SearchBudget(couples_after_first=-1)
+    with pytest.raises(ValueError, match="slice_size_m"):
+        SearchBudget(slice_size_m=0.0)
+    with pytest.raises(ValueError, match="map_cells"):
+        PlannerConfig(map_cells=1)
+    assert SearchBudget(None, None, False).kernel_args() == (-1, -1.0, False)
