@@ -1,14 +1,165 @@
-"""The ``footfall`` command line (placeholder, filled in below)."""
+"""The ``footfall`` command line.
+
+Every command turns bad input into one line on stderr, ``footfall: error: FILE:
+FIELD: REASON``, and exit code 2; ``--json`` output is one JSON object on stdout.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+from typing import Optional
 
 import typer
+from rich.console import Console
+from rich.table import Table
 
-app = typer.Typer(no_args_is_help=True, add_completion=False)
+from footfall._errors import InputError
+
+app = typer.Typer(no_args_is_help=True, add_completion=False, pretty_exceptions_enable=False,
+                  help="footfall: procedural locomotion of multi-legged characters (Abdul Karim et al., CAVW 2012).")
+bench_app = typer.Typer(no_args_is_help=True, help="Benchmarks: tables of measured speed.")
+app.add_typer(bench_app, name="bench")
+
+BUDGET_NAMES = ("first-valid", "default", "exhaustive")
 
 
-@app.callback()
-def _root() -> None:
-    """footfall: procedural locomotion of multi-legged characters."""
+def _stdout() -> Console:
+    return Console(highlight=False)
 
 
-def main() -> None:
-    app()
+def _err() -> Console:
+    return Console(stderr=True, highlight=False)
+
+
+def _budget(name: str):
+    from planner import DEFAULT_BUDGET, EXHAUSTIVE, FIRST_VALID
+
+    budgets = dict(zip(BUDGET_NAMES, (FIRST_VALID, DEFAULT_BUDGET, EXHAUSTIVE)))
+    if name not in budgets:
+        raise InputError("argument", "--budget", f"expected one of {', '.join(BUDGET_NAMES)}, got {name!r}")
+    return budgets[name]
+
+
+def _finite(x: float):
+    return x if math.isfinite(x) else None
+
+
+@app.command("scenarios")
+def scenarios_cmd() -> None:
+    """List the built-in scenarios and creatures."""
+    from scenarios import DEFAULT_SCENARIO, builtin_creature_names, builtin_scenario_names
+
+    out = _stdout()
+    out.print("scenarios: " + ", ".join(f"{n} (default)" if n == DEFAULT_SCENARIO else n for n in builtin_scenario_names()))
+    out.print("creatures: " + ", ".join(builtin_creature_names()))
+
+
+@app.command("check")
+def check_cmd(scenario: str = typer.Argument(..., help="Built-in scenario name or path to a scenario .toml")) -> None:
+    """Load and validate a scenario file (exit code 2 with one line naming the problem)."""
+    from scenarios import load_creature, load_scenario
+
+    s = load_scenario(scenario)
+    creature = load_creature(s.crowd.creature)
+    _stdout().print(f"{s.source}: ok: {s.name}, {len(s.obstacles)} obstacles, {s.crowd.count} x {creature.name} "
+                    f"({creature.n_legs} legs)")
+
+
+@app.command("plan")
+def plan_cmd(
+    scenario: str = typer.Argument("mixed", help="Built-in scenario name or path to a scenario .toml"),
+    creature: Optional[str] = typer.Option(None, help="Creature name or .toml (default: the scenario's)"),
+    budget: str = typer.Option("default", help="Search budget: first-valid, default or exhaustive"),
+    step: Optional[float] = typer.Option(None, help="Step length in m (default: 0.4 x leg reach)"),
+    json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),
+) -> None:
+    """Plan one step of every foot of a creature standing at the scenario's spawn point."""
+    import numpy as np
+
+    from planner import PlannerConfig, WorldRaster, plan_foot
+    from planner._situations import stand, step_queries
+    from scenarios import load_creature, load_scenario
+
+    s = load_scenario(scenario)
+    c = load_creature(creature or s.crowd.creature)
+    search_budget = _budget(budget)
+    if step is not None and not (math.isfinite(step) and step > 0):
+        raise InputError("argument", "--step", f"expected a positive number of metres, got {step}")
+    config = PlannerConfig()
+    raster = WorldRaster.build(s.terrain, s.obstacles, config.cell_size)
+    standing = stand(c, raster, float(s.crowd.centre[0]), float(s.crowd.centre[1]), float(s.crowd.heading), 0.0, config)
+    step_length = step if step is not None else 0.4 * float(c.max_reach)
+    queries = step_queries(c, standing, step_length, 0.3 * float(c.standing_height))
+    results = [plan_foot(standing.maps, q, budget=search_budget, config=config) for q in queries]
+    if json_out:
+        feet = []
+        for leg, q, r in zip(c.leg_names, queries, results):
+            feet.append({
+                "leg": leg, "valid": r.valid, "source": q.source.tolist(), "target": r.target.tolist(),
+                "slice_level_m": _finite(r.slice_level_m), "couple_score": r.couple_score,
+                "footprint_score": r.footprint_score, "trajectory_score": r.trajectory_score,
+                "breakdown": r.breakdown, "metrics": r.metrics, "counters": r.counters,
+            })
+        print(json.dumps({"scenario": s.name, "creature": c.name, "budget": budget, "step_length_m": step_length,
+                          "feet": feet}))
+        return
+    table = Table(title=f"{c.name} on {s.name}: one step of {step_length:.3f} m, budget {budget}")
+    for col in ("leg", "valid", "target (x, y, z) m", "slice", "couple", "footprint", "trajectory", "couples",
+                "cells"):
+        table.add_column(col, justify="right")
+    for leg, r in zip(c.leg_names, results):
+        level = "none" if not math.isfinite(r.slice_level_m) else f"{r.slice_level_m:.2f} m"
+        table.add_row(leg, "yes" if r.valid else "hold", ", ".join(f"{v:.3f}" for v in r.target),
+                      level if r.valid else "-", f"{r.couple_score:.3f}", f"{r.footprint_score:.3f}",
+                      f"{r.trajectory_score:.3f}", str(r.counters["couples_evaluated"]),
+                      str(r.counters["cells_expanded"]))
+    _stdout().print(table)
+    valid = int(np.sum([r.valid for r in results]))
+    _stdout().print(f"{valid} of {len(results)} feet found a couple; the others hold.")
+
+
+@bench_app.command("planner")
+def bench_planner_cmd(
+    json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),
+    poses: int = typer.Option(12, min=1, help="Seeded creature poses per scenario"),
+    seed: int = typer.Option(0, help="Seed of the poses"),
+    repeats: int = typer.Option(3, min=1, help="Runs per measurement (the best is kept)"),
+) -> None:
+    """Median microseconds per foot plan on crates and mixed, and the shared wavefront's speedup."""
+    from benchmarks.planner_bench import run
+
+    err = _err()
+    with err.status("benchmarking the planner...") as status:
+        result = run(n_poses=poses, seed=seed, repeats=repeats, progress=lambda m: status.update(f"benchmarking {m}"))
+    if json_out:
+        print(json.dumps(result))
+        return
+    table = Table(title="Planner: median microseconds per foot plan")
+    table.add_column("scenario")
+    for col in ("first valid", "default", "exhaustive"):
+        table.add_column(col, justify="right")
+    for name, row in result["scenarios"].items():
+        table.add_row(name, f"{row['first_valid_us']:.1f}", f"{row['default_us']:.1f}", f"{row['exhaustive_us']:.1f}")
+    out = _stdout()
+    out.print(table)
+    out.print(f"shared wavefront speedup: {result['speedup_vs_per_target']:.1f}x vs one wavefront per target, "
+              f"{result['speedup_vs_skimage_mcp']:.1f}x vs scikit-image MCP_Geometric "
+              f"({result['details']['wavefront_grids']} foot grids)")
+
+
+def main(argv: list[str] | None = None) -> None:
+    try:
+        app(args=argv, standalone_mode=True)
+    except InputError as e:
+        _err().print(f"footfall: error: {e}", markup=False, soft_wrap=True)
+        sys.exit(2)
+    except ValueError as e:
+        # Argument validation in the libraries names the argument in its message.
+        _err().print(f"footfall: error: argument: {e}", markup=False, soft_wrap=True)
+        sys.exit(2)
+
+
+if __name__ == "__main__":
+    main()

@@ -8,6 +8,7 @@ from planner._cache import configure_numba_cache as _configure_numba_cache
 
 _configure_numba_cache()
 
+from planner._batch import BatchResult, FootBatch, make_batch, plan_batch  # noqa: E402
 from planner._grid import GridFrame  # noqa: E402
 from planner._maps import LocalMaps, WorldRaster  # noqa: E402
 from planner._params import (  # noqa: E402
@@ -27,6 +28,10 @@ from planner._weights import (  # noqa: E402
 )
 
 __all__ = [
+    "BatchResult",
+    "FootBatch",
+    "make_batch",
+    "plan_batch",
     "COUNTERS",
     "DEFAULT_BUDGET",
     "EXHAUSTIVE",

@@ -249,7 +249,8 @@ def slice_levels(code, boxh_dil, slice_size, eps):
     heights = np.empty(boxh_dil.size, dtype=np.float64)
     m = 0
     for p in range(boxh_dil.size):
-        if code[p] != PAD and boxh_dil[p] > eps:
+        # Only free cells matter: forbidden and size-increase cells are blocked in every slice.
+        if code[p] == FREE and boxh_dil[p] > eps:
             heights[m] = boxh_dil[p]
             m += 1
     if m == 0:

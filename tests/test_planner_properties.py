@@ -209,3 +209,24 @@ def test_source_outside_the_maps_is_an_argument_error():
                   foot_length=0.03, foot_width=0.02, foot_yaw=0.0)
     with pytest.raises(ValueError, match="source"):
         plan_foot(maps, q)
+
+
+def test_batch_kernel_equals_single_foot_calls():
+    from planner import make_batch, plan_batch
+
+    rng = np.random.default_rng(11)
+    maps_list, requests, singles = [], [], []
+    while len(requests) < 40:
+        maps, _ = random_layout(rng)
+        q, _ = random_query(rng, maps)
+        if q is None:
+            continue
+        maps_list.append(maps)
+        requests.append((len(maps_list) - 1, q))
+        singles.append(plan_foot(maps, q))
+    out = plan_batch(make_batch(maps_list, requests))
+    for i, r in enumerate(singles):
+        assert out.valid[i] == r.valid
+        np.testing.assert_array_equal(out.trajectory[i], r.trajectory)
+        np.testing.assert_array_equal(out.target[i], r.target)
+        assert out.scores[i, 0] == r.couple_score

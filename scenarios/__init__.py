@@ -1,0 +1,46 @@
+"""Scenario inputs of footfall: terrain, obstacles, creatures, crowd spawns and camera.
+
+Units: metres, seconds, radians. World y is up; the ground plane is x/z.
+A creature's body frame is (forward, up, lateral), lateral positive to its
+left; with heading psi, world forward is (cos psi, 0, sin psi) and world
+lateral is (-sin psi, 0, cos psi).
+
+Everything here is immutable: frozen dataclasses holding read-only NumPy
+arrays. Bad input raises :class:`footfall._errors.InputError`. The TOML file
+formats are described in ``scenarios/README.md``.
+"""
+
+from scenarios._creatures import Creature
+from scenarios._files import builtin_creature_names, builtin_scenario_names, load_creature, load_scenario
+from scenarios._generators import (
+    CrateRecipe,
+    flat_heightfield,
+    hills_heightfield,
+    random_crates,
+    stairs_heightfield,
+)
+from scenarios._obstacles import Obstacles
+from scenarios._scenario import Camera, CrowdSpawn, Scenario
+from scenarios._terrain import Heightfield
+
+DEFAULT_SCENARIO = "mixed"
+"""The scenario used when none is named."""
+
+__all__ = [
+    "DEFAULT_SCENARIO",
+    "Camera",
+    "CrateRecipe",
+    "Creature",
+    "CrowdSpawn",
+    "Heightfield",
+    "Obstacles",
+    "Scenario",
+    "builtin_creature_names",
+    "builtin_scenario_names",
+    "flat_heightfield",
+    "hills_heightfield",
+    "load_creature",
+    "load_scenario",
+    "random_crates",
+    "stairs_heightfield",
+]

@@ -1,0 +1,166 @@
+"""Creature morphology: the paper's "multi-legged character morphology" (§3.1)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from scenarios._arrays import frozen_array, invalid, positive_float, readonly
+
+REST_REACH_FRACTION = 0.98
+"""A rest foot may be at most this fraction of its leg's reach from its hip."""
+
+
+@dataclass(frozen=True, eq=False)
+class Creature:
+    """A multi-legged character's static morphology.
+
+    Body frame: (forward, up, lateral) in m, origin at the pelvis (the body
+    centre), lateral positive to the creature's left. ``L`` legs, each a chain
+    of ``S`` segments (the same ``S`` for every leg).
+
+    Attributes
+    ----------
+    name:
+        Creature name.
+    leg_names:
+        (L,) unique leg names, e.g. ``("L1", ..., "R4")``.
+    hips:
+        (L, 3) hip joint positions, body frame, m.
+    segment_lengths:
+        (L, S) m, hip to foot, S >= 2, all > 0.
+    joint_limits:
+        (L, S, 2) radians, (min, max) of joint ``j`` at the proximal end of
+        segment ``j``; min < max. Convention (see ``scenarios/README.md``):
+        hinges in the leg's vertical plane; joint 0 is the pitch of segment 0
+        below the horizontal, joint j > 0 the bend of segment j relative to
+        segment j - 1, positive = downward.
+    rest_feet:
+        (L, 2) default feet spacing: body-frame (forward, lateral) of each
+        foot at rest, on flat ground ``standing_height`` below the pelvis.
+    foot_length, foot_width:
+        Projected foot rectangle (m); its length runs along the leg's outward
+        direction (hip to rest foot, see :attr:`foot_directions`).
+    body_thickness:
+        Pelvis height above the support hull (m), <= ``standing_height``.
+    body_box:
+        (2,) projected body bounding box (length along forward, width along
+        lateral), m, centred on the pelvis.
+    standing_height:
+        Nominal pelvis height above flat ground (m).
+    """
+
+    name: str
+    leg_names: tuple[str, ...]
+    hips: np.ndarray
+    segment_lengths: np.ndarray
+    joint_limits: np.ndarray
+    rest_feet: np.ndarray
+    foot_length: float
+    foot_width: float
+    body_thickness: float
+    body_box: np.ndarray
+    standing_height: float
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name.strip():
+            raise invalid("name", "must be a non-empty string")
+        names = tuple(self.leg_names)
+        n_legs = len(names)
+        if n_legs == 0:
+            raise invalid("leg_names", "creature needs at least one leg")
+        for i, leg in enumerate(names):
+            if not isinstance(leg, str) or not leg.strip():
+                raise invalid(f"leg_names[{i}]", "must be a non-empty string")
+            if leg in names[:i]:
+                raise invalid(f"leg_names[{i}]", f"duplicate leg name {leg!r}")
+        hips = frozen_array(self.hips, "hips", (n_legs, 3))
+        lengths = frozen_array(self.segment_lengths, "segment_lengths", (n_legs, None))
+        n_segments = lengths.shape[1]
+        if n_segments < 2:
+            raise invalid("segment_lengths", "a leg needs at least 2 segments")
+        limits = frozen_array(self.joint_limits, "joint_limits", (n_legs, n_segments, 2))
+        rest = frozen_array(self.rest_feet, "rest_feet", (n_legs, 2))
+        body_box = frozen_array(self.body_box, "body_box", (2,))
+        if np.any(body_box <= 0.0):
+            raise invalid("body_box", "length and width must be > 0")
+        foot_length = positive_float(self.foot_length, "foot_length")
+        foot_width = positive_float(self.foot_width, "foot_width")
+        thickness = positive_float(self.body_thickness, "body_thickness")
+        height = positive_float(self.standing_height, "standing_height")
+        if thickness > height:
+            raise invalid("body_thickness", f"must not exceed standing_height ({height:g} m)")
+
+        for i in range(n_legs):
+            for j in range(n_segments):
+                if lengths[i, j] <= 0.0:
+                    raise invalid(f"segment_lengths[{i}][{j}]", "must be > 0")
+                if not limits[i, j, 0] < limits[i, j, 1]:
+                    raise invalid(f"joint_limits[{i}][{j}]", "min must be < max")
+            if hips[i, 1] <= -height:
+                raise invalid(f"hips[{i}]", "hip is at or below the ground (up <= -standing_height)")
+            foot = np.array([rest[i, 0], -height, rest[i, 1]])
+            with np.errstate(over="ignore"):  # absurdly large inputs give inf, which the check below refuses
+                distance = float(np.linalg.norm(foot - hips[i]))
+                reach = float(lengths[i].sum())
+            if not (np.isfinite(distance) and np.isfinite(reach)):
+                raise invalid(f"rest_feet[{i}]", "leg dimensions are too large")
+            if distance > REST_REACH_FRACTION * reach:
+                raise invalid(
+                    f"rest_feet[{i}]",
+                    f"rest foot out of reach: {distance:.3f} m from the hip, "
+                    f"leg reach {reach:.3f} m (at most {REST_REACH_FRACTION:g} x reach)",
+                )
+
+        object.__setattr__(self, "leg_names", names)
+        object.__setattr__(self, "hips", hips)
+        object.__setattr__(self, "segment_lengths", lengths)
+        object.__setattr__(self, "joint_limits", limits)
+        object.__setattr__(self, "rest_feet", rest)
+        object.__setattr__(self, "body_box", body_box)
+        object.__setattr__(self, "foot_length", foot_length)
+        object.__setattr__(self, "foot_width", foot_width)
+        object.__setattr__(self, "body_thickness", thickness)
+        object.__setattr__(self, "standing_height", height)
+
+    @property
+    def n_legs(self) -> int:
+        """Number of legs L."""
+        return len(self.leg_names)
+
+    @property
+    def n_segments(self) -> int:
+        """Segments per leg S."""
+        return self.segment_lengths.shape[1]
+
+    @property
+    def leg_reach(self) -> np.ndarray:
+        """(L,) m: each leg's fully stretched length (sum of its segments)."""
+        return readonly(self.segment_lengths.sum(axis=1))
+
+    @property
+    def max_reach(self) -> float:
+        """Longest leg reach (m)."""
+        return float(self.leg_reach.max())
+
+    @property
+    def foot_directions(self) -> np.ndarray:
+        """(L, 2) unit body-frame (forward, lateral) direction from each hip to its rest foot.
+
+        This is the direction along which :attr:`foot_length` runs. A rest foot
+        straight below its hip gets (1, 0) (forward).
+        """
+        offsets = self.rest_feet - self.hips[:, [0, 2]]
+        norms = np.linalg.norm(offsets, axis=1, keepdims=True)
+        safe = norms[:, 0] > 1e-9
+        directions = np.tile([1.0, 0.0], (self.n_legs, 1))
+        directions[safe] = offsets[safe] / norms[safe]
+        return readonly(directions)
+
+    @property
+    def rest_radius(self) -> float:
+        """Radius (m) of the horizontal disk around the pelvis that holds the body box and the rest feet."""
+        body = 0.5 * float(np.hypot(*self.body_box))
+        feet = float(np.linalg.norm(self.rest_feet, axis=1).max()) + 0.5 * max(self.foot_length, self.foot_width)
+        return max(body, feet)

@@ -1,0 +1,428 @@
+"""Loading scenarios and creatures from TOML files and from the built-in catalogue.
+
+See ``scenarios/README.md`` for the file formats.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import tomllib
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from footfall._errors import InputError
+from scenarios import _schema as schema
+from scenarios._arrays import UNATTRIBUTED, one_line
+from scenarios._creatures import Creature
+from scenarios._generators import (
+    CrateRecipe,
+    flat_heightfield,
+    hills_heightfield,
+    random_crates,
+    resting_y,
+    stairs_heightfield,
+    terrain_loop,
+)
+from scenarios._heightmaps import read_heightmap
+from scenarios._obstacles import STATIC, VELOCITY, WAYPOINTS, Obstacles
+from scenarios._scenario import Camera, CrowdSpawn, Scenario
+from scenarios._terrain import Heightfield
+
+DATA_DIR = Path(__file__).parent / "data"
+"""Built-in scenarios (``*.toml``)."""
+CREATURES_DIR = DATA_DIR / "creatures"
+"""Built-in creatures (``*.toml``)."""
+
+_DEFAULT_REGION_INSET = 0.5  # m: default [obstacles_random] region is the terrain minus this border
+_DEFAULT_CAMERA_BACK = 4.0  # m behind the crowd
+_DEFAULT_CAMERA_UP = 3.0  # m above the crowd
+_DEFAULT_FOV = 0.9  # radians
+
+
+# --------------------------------------------------------------------------- catalogue
+
+
+def builtin_scenario_names() -> tuple[str, ...]:
+    """Names of the built-in scenarios, sorted."""
+    return tuple(sorted(path.stem for path in DATA_DIR.glob("*.toml")))
+
+
+def builtin_creature_names() -> tuple[str, ...]:
+    """Names of the built-in creatures, sorted."""
+    return tuple(sorted(path.stem for path in CREATURES_DIR.glob("*.toml")))
+
+
+def _is_file(path: Path) -> bool:
+    """``path.is_file()``, False for names the OS refuses (e.g. with a NUL byte)."""
+    try:
+        return path.is_file()
+    except (OSError, ValueError):
+        return False
+
+
+def _resolve(name_or_path: str | Path, directory: Path, builtins: tuple[str, ...], what: str) -> tuple[Path, str]:
+    """(path to read, label for errors) of a built-in name or a file path.
+
+    A ``Path`` is always a file path. A string is a built-in name if it is
+    one, else a file path. Raises :class:`InputError` (file ``name_or_path``,
+    field ``what``) when it is neither.
+    """
+    text = str(name_or_path)
+    if isinstance(name_or_path, str) and name_or_path in builtins:
+        return directory / f"{name_or_path}.toml", f"builtin:{name_or_path}"
+    path = Path(name_or_path)
+    if _is_file(path):
+        return path, text
+    if isinstance(name_or_path, Path) or path.suffix == ".toml" or "/" in text or "\\" in text:
+        raise InputError(text, what, "file not found")
+    raise InputError(text, what, f"unknown {what}; built-ins are: {', '.join(builtins)}")
+
+
+def _read_toml(path: Path, file: str, what: str) -> dict[str, Any]:
+    try:
+        text = path.read_bytes().decode("utf-8")
+    except OSError as error:
+        raise InputError(file, what, f"cannot read file: {one_line(error.strerror or error)}") from None
+    except UnicodeDecodeError:
+        raise InputError(file, what, "not UTF-8 text") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as error:
+        raise InputError(file, what, f"invalid TOML: {one_line(error)}") from None
+
+
+_INDEXED = re.compile(r"^(\w+)((?:\[\d+\])*)$")
+
+
+def _split_field(field: str) -> tuple[str, list[int]]:
+    """``"rest_feet[2][1]"`` -> ``("rest_feet", [2, 1])``."""
+    match = _INDEXED.match(field)
+    if not match:
+        return field, []
+    return match.group(1), [int(i) for i in re.findall(r"\d+", match.group(2))]
+
+
+# --------------------------------------------------------------------------- creatures
+
+
+def load_creature(name_or_path: str | Path) -> Creature:
+    """A built-in creature by name (see :func:`builtin_creature_names`) or a creature ``.toml`` file.
+
+    Raises :class:`InputError` naming the file and field on any problem.
+    """
+    path, file = _resolve(name_or_path, CREATURES_DIR, builtin_creature_names(), "creature")
+    return _load_creature_file(path, file)
+
+
+def _load_creature_file(path: Path, file: str) -> Creature:
+    model: schema.CreatureFile = schema.validate(schema.CreatureFile, _read_toml(path, file, "creature"), file)
+    if not model.legs:
+        raise InputError(file, "legs", "creature needs at least one leg")
+    defaults = model.leg_defaults
+    segments: list[list[float]] = []
+    limits: list[list[list[float]]] = []
+    segments_field: list[str] = []  # where each leg's segments / joint limits came from
+    limits_field: list[str] = []
+    for i, leg in enumerate(model.legs):
+        own_segments = leg.segments is not None
+        leg_segments = leg.segments if own_segments else defaults.segments
+        segments_field.append(f"legs[{i}].segments" if own_segments else "leg_defaults.segments")
+        if leg_segments is None:
+            raise InputError(file, f"legs[{i}].segments", "required (or give leg_defaults.segments)")
+        if len(leg_segments) < 2:
+            raise InputError(file, segments_field[i], "a leg needs at least 2 segments")
+        if len(leg_segments) != len(segments[0] if segments else leg_segments):
+            raise InputError(file, segments_field[i],
+                             f"every leg needs the same number of segments (legs[0] has {len(segments[0])})")
+        own_limits = leg.joint_limits is not None
+        leg_limits = leg.joint_limits if own_limits else defaults.joint_limits
+        limits_field.append(f"legs[{i}].joint_limits" if own_limits else "leg_defaults.joint_limits")
+        if leg_limits is None:
+            raise InputError(file, f"legs[{i}].joint_limits", "required (or give leg_defaults.joint_limits)")
+        if len(leg_limits) != len(leg_segments):
+            raise InputError(file, limits_field[i],
+                             f"expected one [min, max] per segment ({len(leg_segments)}), got {len(leg_limits)}")
+        segments.append(leg_segments)
+        limits.append(leg_limits)
+
+    def file_field(field: str) -> str:
+        name, index = _split_field(field)
+        leg_fields = {"leg_names": "name", "hips": "hip", "rest_feet": "rest_foot"}
+        if name == "leg_names" and not index:
+            return "legs"
+        if name in leg_fields and index:
+            return f"legs[{index[0]}].{leg_fields[name]}"
+        if name == "segment_lengths" and index:
+            return segments_field[index[0]] + "".join(f"[{k}]" for k in index[1:])
+        if name == "joint_limits" and index:
+            return limits_field[index[0]] + "".join(f"[{k}]" for k in index[1:])
+        return {"foot_length": "foot.length", "foot_width": "foot.width"}.get(name, field)
+
+    try:
+        return Creature(
+            name=model.name or path.stem,
+            leg_names=tuple(leg.name for leg in model.legs),
+            hips=[leg.hip for leg in model.legs],
+            segment_lengths=segments,
+            joint_limits=limits,
+            rest_feet=[leg.rest_foot for leg in model.legs],
+            foot_length=model.foot.length,
+            foot_width=model.foot.width,
+            body_thickness=model.body_thickness,
+            body_box=model.body_box,
+            standing_height=model.standing_height,
+        )
+    except InputError as error:
+        if error.file != UNATTRIBUTED:
+            raise
+        raise InputError(file, file_field(error.field), error.reason) from None
+
+
+# --------------------------------------------------------------------------- scenarios
+
+
+def load_scenario(name_or_path: str | Path) -> Scenario:
+    """A built-in scenario by name (see :func:`builtin_scenario_names`) or a scenario ``.toml`` file.
+
+    Paths inside the file (height maps, creature files) are relative to the
+    file. Raises :class:`InputError` naming the file and field on any problem.
+    """
+    path, file = _resolve(name_or_path, DATA_DIR, builtin_scenario_names(), "scenario")
+    model: schema.ScenarioFile = schema.validate(schema.ScenarioFile, _read_toml(path, file, "scenario"), file)
+    base = path.parent
+
+    terrain = _attributed(file, "terrain", lambda: _build_terrain(model.terrain, model.seed, base, file))
+    creature_ref, creature = _crowd_creature(model.crowd.creature, base, file)
+    crowd = _attributed(file, "crowd", lambda: CrowdSpawn(
+        creature=creature_ref,
+        count=model.crowd.count,
+        centre=model.crowd.centre,
+        radius=model.crowd.radius,
+        heading=model.crowd.heading,
+        heading_mode=model.crowd.heading_mode,
+        speed=model.crowd.speed,
+        goal=model.crowd.goal,
+        waypoints=model.crowd.waypoints,
+        feet_spacing=model.crowd.feet_spacing,
+    ))
+    creature_radius = creature.rest_radius * crowd.feet_spacing
+    _check_crowd_on_terrain(crowd, creature_radius, terrain, file)
+
+    obstacles = _explicit_obstacles(model.obstacles, terrain, crowd, creature_radius, file)
+    if model.obstacles_random is not None:
+        generated = _random_obstacles(model.obstacles_random, model.seed, terrain, crowd, creature_radius, obstacles, file)
+        obstacles = _concatenate(obstacles, generated)
+
+    camera = _attributed(file, "camera", lambda: _build_camera(model.camera, crowd, terrain))
+    return Scenario(
+        name=model.name or path.stem,
+        source=file,
+        terrain=terrain,
+        obstacles=obstacles,
+        crowd=crowd,
+        camera=camera,
+        seed=model.seed,
+        description=model.description,
+    )
+
+
+def _attributed(file: str, prefix: str, build: Any) -> Any:
+    """``build()``, re-raising an unattributed :class:`InputError` as one about ``file`` / ``prefix.field``."""
+    try:
+        return build()
+    except InputError as error:
+        if error.file != UNATTRIBUTED:
+            raise
+        raise InputError(file, f"{prefix}.{error.field}", error.reason) from None
+
+
+def _build_terrain(terrain: Any, seed: int, base: Path, file: str) -> Heightfield:
+    if isinstance(terrain, schema.FlatTerrainFile):
+        return flat_heightfield(tuple(terrain.size), terrain.cell_size, terrain.height)
+    if isinstance(terrain, schema.HillsTerrainFile):
+        return hills_heightfield(
+            tuple(terrain.size),
+            terrain.cell_size,
+            terrain.amplitude,
+            terrain.wavelength,
+            terrain.octaves,
+            terrain.persistence,
+            seed if terrain.seed is None else terrain.seed,
+        )
+    if isinstance(terrain, schema.StairsTerrainFile):
+        return stairs_heightfield(
+            tuple(terrain.size),
+            terrain.cell_size,
+            terrain.rise,
+            terrain.run,
+            terrain.steps,
+            terrain.start,
+            terrain.direction,
+            terrain.landing,
+        )
+    raw = read_heightmap(base / terrain.file, file, "terrain.file")
+    rows, cols = raw.shape
+    heights = raw * terrain.height_scale + terrain.height_offset
+    if not np.all(np.isfinite(heights)):
+        raise InputError(file, "terrain.height_scale", "scaled heights overflow")
+    return Heightfield(
+        heights,
+        origin_x=-0.5 * (cols - 1) * terrain.cell_size,
+        origin_z=-0.5 * (rows - 1) * terrain.cell_size,
+        cell_size=terrain.cell_size,
+    )
+
+
+def _crowd_creature(reference: str, base: Path, file: str) -> tuple[str, Creature]:
+    """(reference to store in :class:`CrowdSpawn`, loaded creature) for ``crowd.creature``."""
+    names = builtin_creature_names()
+    if reference in names:
+        return reference, load_creature(reference)
+    path = Path(reference)
+    if not path.is_absolute():
+        path = base / path
+    if not _is_file(path):
+        if path.suffix == ".toml" or "/" in reference or "\\" in reference:
+            raise InputError(file, "crowd.creature", f"creature file not found: {path}")
+        raise InputError(file, "crowd.creature", f"unknown creature {reference!r}; built-ins are: {', '.join(names)}")
+    return str(path), _load_creature_file(path, str(path))
+
+
+def _check_crowd_on_terrain(crowd: CrowdSpawn, creature_radius: float, terrain: Heightfield, file: str) -> None:
+    (x0, x1), (z0, z1) = terrain.x_range, terrain.z_range
+    extent = f"x in [{x0:g}, {x1:g}], z in [{z0:g}, {z1:g}]"
+    if not terrain.contains(*crowd.centre):
+        raise InputError(file, "crowd.centre", f"outside the terrain ({extent})")
+    if not terrain.contains(*crowd.centre, margin=crowd.radius + creature_radius):
+        raise InputError(file, "crowd.radius", "spawn disk (plus the creature's size) extends beyond the terrain")
+    if not terrain.contains(*crowd.goal):
+        raise InputError(file, "crowd.goal", f"outside the terrain ({extent})")
+    for i, point in enumerate(crowd.waypoints):
+        if not terrain.contains(*point):
+            raise InputError(file, f"crowd.waypoints[{i}]", f"outside the terrain ({extent})")
+
+
+def _box_touches_disk(centre_xz: np.ndarray, size: np.ndarray, yaw: float, disk_xz: np.ndarray, radius: float) -> bool:
+    """Whether a box footprint (centre (x, z), extents, yaw) overlaps a disk."""
+    dx, dz = disk_xz - centre_xz
+    local_x = dx * math.cos(yaw) + dz * math.sin(yaw)
+    local_z = -dx * math.sin(yaw) + dz * math.cos(yaw)
+    nearest_x = min(max(local_x, -0.5 * size[0]), 0.5 * size[0])
+    nearest_z = min(max(local_z, -0.5 * size[2]), 0.5 * size[2])
+    return math.hypot(local_x - nearest_x, local_z - nearest_z) < radius
+
+
+def _explicit_obstacles(
+    entries: list[schema.ObstacleFile], terrain: Heightfield, crowd: CrowdSpawn, creature_radius: float, file: str
+) -> Obstacles:
+    n = len(entries)
+    centres = np.zeros((n, 3))
+    sizes = np.zeros((n, 3))
+    yaws = np.zeros(n)
+    forbidden = np.zeros(n, bool)
+    kinds = np.zeros(n, np.int8)
+    velocities = np.zeros((n, 3))
+    waypoints: list[np.ndarray] = [np.zeros((0, 3))] * n
+    speeds = np.zeros(n)
+    spawn_radius = crowd.radius + creature_radius
+    for i, entry in enumerate(entries):
+        where = f"obstacles[{i}]"
+        x, z = entry.centre
+        if not terrain.contains(x, z):
+            raise InputError(file, f"{where}.centre", "outside the terrain")
+        sizes[i] = entry.size
+        yaws[i] = entry.yaw
+        forbidden[i] = entry.kind == "forbidden"
+        centres[i] = (x, float(resting_y(terrain, x, z, sizes[i, 1], entry.lift)), z)
+        if _box_touches_disk(np.array([x, z]), sizes[i], yaws[i], crowd.centre, spawn_radius):
+            raise InputError(file, f"{where}.centre",
+                             f"box overlaps the crowd spawn area ({spawn_radius:.2f} m around crowd.centre)")
+        motion = entry.motion
+        if isinstance(motion, schema.VelocityMotionFile):
+            kinds[i] = VELOCITY
+            velocities[i] = (motion.velocity[0], 0.0, motion.velocity[1])
+        elif isinstance(motion, schema.WaypointsMotionFile):
+            kinds[i] = WAYPOINTS
+            for j, (px, pz) in enumerate(motion.points):
+                if not terrain.contains(px, pz):
+                    raise InputError(file, f"{where}.motion.points[{j}]", "outside the terrain")
+            loop_xz = np.vstack([[x, z], motion.points])
+            if not np.any(np.linalg.norm(loop_xz - loop_xz[0], axis=1) > 0.0):
+                raise InputError(file, f"{where}.motion.points", "the loop has zero length (all points at centre)")
+            loop = terrain_loop(terrain, loop_xz, sizes[i, 1], entry.lift)
+            loop[0] = centres[i]
+            waypoints[i] = loop
+            speeds[i] = motion.speed
+        else:
+            kinds[i] = STATIC
+    return Obstacles(centres, sizes, yaws, forbidden, kinds, velocities, tuple(waypoints), speeds)
+
+
+def _random_obstacles(
+    entry: schema.RandomObstaclesFile,
+    seed: int,
+    terrain: Heightfield,
+    crowd: CrowdSpawn,
+    creature_radius: float,
+    existing: Obstacles,
+    file: str,
+) -> Obstacles:
+    (x0, x1), (z0, z1) = terrain.x_range, terrain.z_range
+    region_min = entry.region_min or [x0 + _DEFAULT_REGION_INSET, z0 + _DEFAULT_REGION_INSET]
+    region_max = entry.region_max or [x1 - _DEFAULT_REGION_INSET, z1 - _DEFAULT_REGION_INSET]
+    for name, (x, z) in (("region_min", region_min), ("region_max", region_max)):
+        if not terrain.contains(x, z):
+            raise InputError(file, f"obstacles_random.{name}", "outside the terrain")
+    keep_out = [(*crowd.centre, crowd.radius + creature_radius + entry.keep_out)]
+    keep_out += [(*point, creature_radius + entry.keep_out) for point in crowd.route]
+    occupied = [
+        (c[0], c[2], 0.5 * float(np.hypot(s[0], s[2])))
+        for c, s in zip(existing.centres, existing.sizes)
+    ]
+    recipe = CrateRecipe(
+        count=entry.count,
+        region=(region_min[0], region_min[1], region_max[0], region_max[1]),
+        footprint_range=tuple(entry.footprint_range),
+        height_range=tuple(entry.height_range),
+        safe_height_range=None if entry.safe_height_range is None else tuple(entry.safe_height_range),
+        forbidden_fraction=entry.forbidden_fraction,
+        moving_fraction=entry.moving_fraction,
+        velocity_fraction=entry.velocity_fraction,
+        speed_range=tuple(entry.speed_range),
+        loop_radius_range=tuple(entry.loop_radius_range),
+        min_gap=entry.min_gap,
+    )
+    field_names = {"region": "region_min"}
+    try:
+        return random_crates(terrain, recipe, seed if entry.seed is None else entry.seed, tuple(keep_out), tuple(occupied))
+    except InputError as error:
+        if error.file != UNATTRIBUTED:
+            raise
+        raise InputError(file, f"obstacles_random.{field_names.get(error.field, error.field)}", error.reason) from None
+
+
+def _concatenate(first: Obstacles, second: Obstacles) -> Obstacles:
+    return Obstacles(
+        np.vstack([first.centres, second.centres]),
+        np.vstack([first.sizes, second.sizes]),
+        np.concatenate([first.yaws, second.yaws]),
+        np.concatenate([first.forbidden, second.forbidden]),
+        np.concatenate([first.motion_kind, second.motion_kind]),
+        np.vstack([first.velocities, second.velocities]),
+        first.waypoints + second.waypoints,
+        np.concatenate([first.waypoint_speed, second.waypoint_speed]),
+    )
+
+
+def _build_camera(entry: schema.CameraFile | None, crowd: CrowdSpawn, terrain: Heightfield) -> Camera:
+    if entry is not None:
+        return Camera(entry.position, entry.target, entry.fov)
+    cx, cz = crowd.centre
+    target = np.array([cx, float(terrain.height_at(cx, cz)), cz])
+    heading = crowd.heading if crowd.heading_mode == "fixed" else 0.0
+    back = np.array([math.cos(heading), 0.0, math.sin(heading)]) * _DEFAULT_CAMERA_BACK
+    position = target - back + np.array([0.0, _DEFAULT_CAMERA_UP, 0.0])
+    return Camera(position, target, _DEFAULT_FOV)

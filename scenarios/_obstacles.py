@@ -1,0 +1,168 @@
+"""Obstacles: oriented boxes (the paper's crates, §7), static or moving."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from scenarios._arrays import finite_float, frozen_array, invalid, readonly
+
+STATIC = 0
+"""``motion_kind`` of a box that never moves."""
+VELOCITY = 1
+"""``motion_kind`` of a box moving at constant velocity."""
+WAYPOINTS = 2
+"""``motion_kind`` of a box looping along a closed polyline at constant speed."""
+
+_NO_WAYPOINTS = readonly(np.zeros((0, 3)))
+
+
+@dataclass(frozen=True, eq=False)
+class Obstacles:
+    """``n`` oriented boxes (n may be 0), stored as one array per attribute.
+
+    Box ``i`` at time t = 0 has its centre at ``centres[i]`` (world, m) and
+    full extents ``sizes[i]`` (m) along its local (x, y, z) axes. It is turned
+    by ``yaws[i]`` (radians) about +y: local x is world
+    (cos yaw, 0, sin yaw) and local z is world (-sin yaw, 0, cos yaw), the
+    same convention as a creature's (forward, lateral). Local y is world up.
+
+    ``forbidden[i]`` is True when feet must go around the box, False when the
+    box is safe to step on.
+
+    Motion (``motion_kind[i]``): 0 static; 1 constant velocity
+    ``velocities[i]`` (m/s); 2 looping along the closed polyline
+    ``waypoints[i]`` ((k, 3) world points, k >= 2, ``waypoints[i][0] ==
+    centres[i]``) at ``waypoint_speed[i]`` m/s, measured along the 3-D
+    polyline, returning from the last point to the first. Yaw never changes.
+    Unused motion data are zero: ``velocities[i]`` is (0, 0, 0) unless kind 1,
+    ``waypoints[i]`` is (0, 3) and ``waypoint_speed[i]`` is 0 unless kind 2.
+
+    Only ``centres``, ``sizes``, ``yaws`` and ``forbidden`` are required; the
+    motion fields default to "all static". Every array is copied and made
+    read-only.
+    """
+
+    centres: np.ndarray
+    sizes: np.ndarray
+    yaws: np.ndarray
+    forbidden: np.ndarray
+    motion_kind: np.ndarray | None = None
+    velocities: np.ndarray | None = None
+    waypoints: tuple[np.ndarray, ...] | None = None
+    waypoint_speed: np.ndarray | None = None
+    # Per box with motion kind 2: cumulative arc length at each waypoint, closing segment included ((k + 1,)).
+    _loop_lengths: tuple[np.ndarray, ...] = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        centres = frozen_array(_rows_of_3(self.centres), "centres", (None, 3))
+        n = centres.shape[0]
+        sizes = frozen_array(_rows_of_3(self.sizes), "sizes", (n, 3))
+        for i in range(n):
+            if np.any(sizes[i] <= 0.0):
+                raise invalid(f"sizes[{i}]", "box extents must be > 0")
+        yaws = frozen_array(self.yaws, "yaws", (n,))
+        forbidden = frozen_array(self.forbidden, "forbidden", (n,), dtype=bool)
+
+        kind = np.zeros(n, np.int8) if self.motion_kind is None else self.motion_kind
+        kind = frozen_array(kind, "motion_kind", (n,), dtype=np.int8)
+        for i in range(n):
+            if kind[i] not in (STATIC, VELOCITY, WAYPOINTS):
+                raise invalid(f"motion_kind[{i}]", "must be 0 (static), 1 (velocity) or 2 (waypoints)")
+        velocities = np.zeros((n, 3)) if self.velocities is None else self.velocities
+        velocities = frozen_array(_rows_of_3(velocities), "velocities", (n, 3))
+        speeds = np.zeros(n) if self.waypoint_speed is None else self.waypoint_speed
+        speeds = frozen_array(speeds, "waypoint_speed", (n,))
+        raw_points = (_NO_WAYPOINTS,) * n if self.waypoints is None else tuple(self.waypoints)
+        if len(raw_points) != n:
+            raise invalid("waypoints", f"expected one array per box ({n}), got {len(raw_points)}")
+
+        points: list[np.ndarray] = []
+        loops: list[np.ndarray] = []
+        for i in range(n):
+            p = frozen_array(_rows_of_3(raw_points[i]), f"waypoints[{i}]", (None, 3))
+            if kind[i] != VELOCITY and np.any(velocities[i] != 0.0):
+                raise invalid(f"velocities[{i}]", "must be zero unless motion_kind is 1 (velocity)")
+            if kind[i] == WAYPOINTS:
+                if p.shape[0] < 2:
+                    raise invalid(f"waypoints[{i}]", "a waypoint loop needs at least 2 points")
+                if not speeds[i] > 0.0:
+                    raise invalid(f"waypoint_speed[{i}]", "must be > 0 for a waypoint loop")
+                if not np.allclose(p[0], centres[i], rtol=0.0, atol=1e-9):
+                    raise invalid(f"waypoints[{i}]", "the first waypoint must equal the box centre")
+                segment = np.linalg.norm(np.roll(p, -1, axis=0) - p, axis=1)
+                cumulative = readonly(np.concatenate(([0.0], np.cumsum(segment))))
+                if not cumulative[-1] > 0.0:
+                    raise invalid(f"waypoints[{i}]", "the waypoint loop has zero length")
+                loops.append(cumulative)
+            else:
+                if p.shape[0] != 0:
+                    raise invalid(f"waypoints[{i}]", "must be empty unless motion_kind is 2 (waypoints)")
+                if speeds[i] != 0.0:
+                    raise invalid(f"waypoint_speed[{i}]", "must be zero unless motion_kind is 2 (waypoints)")
+                loops.append(_NO_WAYPOINTS[:, 0])
+            points.append(p)
+
+        object.__setattr__(self, "centres", centres)
+        object.__setattr__(self, "sizes", sizes)
+        object.__setattr__(self, "yaws", yaws)
+        object.__setattr__(self, "forbidden", forbidden)
+        object.__setattr__(self, "motion_kind", kind)
+        object.__setattr__(self, "velocities", velocities)
+        object.__setattr__(self, "waypoints", tuple(points))
+        object.__setattr__(self, "waypoint_speed", speeds)
+        object.__setattr__(self, "_loop_lengths", tuple(loops))
+
+    @classmethod
+    def empty(cls) -> Obstacles:
+        """No obstacles at all."""
+        return cls(np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), np.zeros(0, bool))
+
+    def __len__(self) -> int:
+        """Number of boxes."""
+        return self.centres.shape[0]
+
+    @property
+    def is_static(self) -> np.ndarray:
+        """(n,) bool: True for boxes that never move (motion kind 0)."""
+        return readonly(self.motion_kind == STATIC)
+
+    def poses_at(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """Box centres (n, 3) (world, m) and yaws (n,) (radians) at time ``t`` (s).
+
+        Static boxes stay at ``centres``; constant-velocity boxes are at
+        ``centres + t * velocities`` (also for t < 0); waypoint boxes have
+        travelled ``waypoint_speed * t`` metres along their closed loop,
+        starting from waypoint 0 at t = 0. Returns fresh, writable arrays.
+        """
+        t = finite_float(t, "t")
+        centres = np.array(self.centres)
+        moving = self.motion_kind == VELOCITY
+        centres[moving] += t * self.velocities[moving]
+        for i in np.flatnonzero(self.motion_kind == WAYPOINTS):
+            centres[i] = _point_on_loop(self.waypoints[i], self._loop_lengths[i], self.waypoint_speed[i] * t)
+        return centres, np.array(self.yaws)
+
+
+def _rows_of_3(value: object) -> object:
+    """``value``, or a (0, 3) array if it is empty (so ``[]`` means "no rows")."""
+    try:
+        return np.zeros((0, 3)) if np.size(value) == 0 else value
+    except (TypeError, ValueError):  # ragged input: let frozen_array report it
+        return value
+
+
+def _point_on_loop(points: np.ndarray, cumulative: np.ndarray, distance: float) -> np.ndarray:
+    """The point ``distance`` m along the closed polyline ``points`` (wrapping, either direction)."""
+    length = cumulative[-1]
+    s = distance % length
+    if not 0.0 <= s < length:  # float modulo can round up to ``length``
+        s = 0.0
+    k = points.shape[0]
+    j = min(int(np.searchsorted(cumulative, s, side="right")) - 1, k - 1)
+    segment = cumulative[j + 1] - cumulative[j]
+    fraction = 0.0 if segment <= 0.0 else min(max((s - cumulative[j]) / segment, 0.0), 1.0)
+    start = points[j]
+    end = points[(j + 1) % k]
+    return start + fraction * (end - start)

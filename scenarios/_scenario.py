@@ -1,0 +1,175 @@
+"""A whole scenario: terrain, obstacles, the crowd to spawn and a camera."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from scenarios._arrays import finite_float, frozen_array, invalid, positive_float, readonly
+from scenarios._obstacles import Obstacles
+from scenarios._terrain import Heightfield
+
+HEADING_MODES = ("fixed", "random")
+_GOLDEN_ANGLE = math.pi * (3.0 - math.sqrt(5.0))
+
+
+@dataclass(frozen=True, eq=False)
+class CrowdSpawn:
+    """Where and how to spawn a crowd of identical creatures, and where they walk.
+
+    Attributes
+    ----------
+    creature:
+        Built-in creature name, or path to a creature ``.toml`` (loaders store
+        it already resolved against the scenario file); pass to
+        :func:`scenarios.load_creature`.
+    count:
+        Number of creatures, >= 1.
+    centre:
+        (2,) world (x, z) of the spawn disk centre, m.
+    radius:
+        Spawn disk radius (m), >= 0 (0 with one creature: spawn at ``centre``).
+    heading:
+        Initial heading (radians) when ``heading_mode == "fixed"``; world
+        forward is (cos heading, 0, sin heading).
+    heading_mode:
+        ``"fixed"``: every creature faces ``heading``; ``"random"``: each
+        creature draws a heading uniformly in [-pi, pi) (see :meth:`initial_poses`).
+    speed:
+        Desired walking speed (m/s), > 0.
+    goal:
+        (2,) world (x, z) of the final destination, m.
+    waypoints:
+        (k, 2) world (x, z) points visited in order before ``goal`` (k may be 0).
+    feet_spacing:
+        Scale (> 0) applied to the creature's rest feet (forward, lateral).
+    """
+
+    creature: str
+    count: int
+    centre: np.ndarray
+    radius: float
+    heading: float
+    heading_mode: str
+    speed: float
+    goal: np.ndarray
+    waypoints: np.ndarray | None = None
+    feet_spacing: float = 1.0
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.creature, str) or not self.creature.strip():
+            raise invalid("creature", "must be a non-empty string")
+        if isinstance(self.count, bool) or not isinstance(self.count, (int, np.integer)) or self.count < 1:
+            raise invalid("count", "must be an integer >= 1")
+        object.__setattr__(self, "count", int(self.count))
+        object.__setattr__(self, "centre", frozen_array(self.centre, "centre", (2,)))
+        radius = finite_float(self.radius, "radius")
+        if radius < 0.0:
+            raise invalid("radius", "must be >= 0")
+        object.__setattr__(self, "radius", radius)
+        object.__setattr__(self, "heading", finite_float(self.heading, "heading"))
+        if self.heading_mode not in HEADING_MODES:
+            raise invalid("heading_mode", f"must be one of {', '.join(HEADING_MODES)}")
+        object.__setattr__(self, "speed", positive_float(self.speed, "speed"))
+        object.__setattr__(self, "goal", frozen_array(self.goal, "goal", (2,)))
+        waypoints = np.zeros((0, 2)) if self.waypoints is None or np.size(self.waypoints) == 0 else self.waypoints
+        object.__setattr__(self, "waypoints", frozen_array(waypoints, "waypoints", (None, 2)))
+        object.__setattr__(self, "feet_spacing", positive_float(self.feet_spacing, "feet_spacing"))
+
+    @property
+    def route(self) -> np.ndarray:
+        """(k + 1, 2) world (x, z) points to walk through in order: the waypoints, then the goal."""
+        return readonly(np.vstack([self.waypoints, self.goal[None, :]]))
+
+    def initial_poses(self, seed: int) -> tuple[np.ndarray, np.ndarray]:
+        """Deterministic start positions (count, 2) (world x, z, m) and headings (count,) (radians).
+
+        Positions follow a sunflower spiral inside the spawn disk: creature 0 at
+        the centre, the others spread evenly out to about ``radius``; adjacent
+        creatures are roughly ``radius * sqrt(pi / count)`` apart. Headings are
+        ``heading`` for ``"fixed"``, or drawn from ``np.random.default_rng(seed)``
+        for ``"random"``.
+        """
+        i = np.arange(self.count)
+        r = self.radius * np.sqrt(i / self.count)
+        angle = i * _GOLDEN_ANGLE
+        positions = self.centre + np.stack([r * np.cos(angle), r * np.sin(angle)], axis=1)
+        if self.heading_mode == "random":
+            headings = np.random.default_rng(seed).uniform(-math.pi, math.pi, self.count)
+        else:
+            headings = np.full(self.count, self.heading)
+        return positions, headings
+
+
+@dataclass(frozen=True, eq=False)
+class Camera:
+    """A pinhole camera looking from ``position`` at ``target``.
+
+    Attributes
+    ----------
+    position, target:
+        (3,) world points, m; they must differ.
+    fov:
+        Vertical field of view (radians), 0 < fov < pi.
+    """
+
+    position: np.ndarray
+    target: np.ndarray
+    fov: float
+
+    def __post_init__(self) -> None:
+        position = frozen_array(self.position, "position", (3,))
+        target = frozen_array(self.target, "target", (3,))
+        if np.allclose(position, target, rtol=0.0, atol=1e-9):
+            raise invalid("target", "must differ from position")
+        fov = finite_float(self.fov, "fov")
+        if not 0.0 < fov < math.pi:
+            raise invalid("fov", "must be between 0 and pi radians (exclusive)")
+        object.__setattr__(self, "position", position)
+        object.__setattr__(self, "target", target)
+        object.__setattr__(self, "fov", fov)
+
+
+@dataclass(frozen=True, eq=False)
+class Scenario:
+    """Everything the simulation needs to know about a scene.
+
+    Attributes
+    ----------
+    name:
+        Scenario name.
+    source:
+        Path of the scenario file as given, or ``"builtin:NAME"``.
+    terrain, obstacles, crowd, camera:
+        The scene (see the respective classes).
+    seed:
+        Scenario seed (>= 0), for anything random left to the simulation,
+        e.g. :meth:`CrowdSpawn.initial_poses`.
+    description:
+        Free text.
+    """
+
+    name: str
+    source: str
+    terrain: Heightfield
+    obstacles: Obstacles
+    crowd: CrowdSpawn
+    camera: Camera
+    seed: int
+    description: str = ""
+
+    def __post_init__(self) -> None:
+        checks = (
+            ("terrain", Heightfield),
+            ("obstacles", Obstacles),
+            ("crowd", CrowdSpawn),
+            ("camera", Camera),
+        )
+        for name, cls in checks:
+            if not isinstance(getattr(self, name), cls):
+                raise invalid(name, f"expected a {cls.__name__}")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or self.seed < 0:
+            raise invalid("seed", "must be an integer >= 0")
+        object.__setattr__(self, "seed", int(self.seed))
