@@ -120,6 +120,90 @@ def plan_cmd(
     _stdout().print(f"{valid} of {len(results)} feet found a couple; the others hold.")
 
 
+@app.command("simulate")
+def simulate_cmd(
+    scenario: str = typer.Argument("mixed", help="Built-in scenario name or path to a scenario .toml"),
+    frames: int = typer.Option(300, min=1, help="Frames of 1/30 s"),
+    characters: Optional[int] = typer.Option(None, min=1, help="Crowd size (default: the scenario's)"),
+    creature: Optional[str] = typer.Option(None, help="Creature name or .toml (default: the scenario's)"),
+    gait: Optional[str] = typer.Option(None, help="Gait name or .toml (default: the creature's)"),
+    lod: str = typer.Option("off", help="Level of detail: on, zoomed or off"),
+    seed: int = typer.Option(0, help="Seed (same seed, same recording)"),
+    preset: Optional[str] = typer.Option(None, help="Weight preset (.json) for this creature"),
+    record: Optional[str] = typer.Option(None, help="Save the recording (.npz)"),
+    json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),
+) -> None:
+    """Simulate a crowd walking through a scenario and report what happened."""
+    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
+    from planner._crowd import init_crowd
+    from planner._presets import load_preset
+    from planner._simulation import Recorder, simulate
+    from scenarios import default_gait_name, load_creature, load_gait, load_scenario
+
+    s = load_scenario(scenario)
+    c = load_creature(creature or s.crowd.creature)
+    g = load_gait(gait or default_gait_name(c.name), c)
+    weights = timing = None
+    if preset is not None:
+        p = load_preset(preset, c.name)
+        weights, timing = p.weights, p.timing
+    if record is not None and not record.endswith(".npz"):
+        raise InputError("argument", "--record", f"expected a .npz path, got {record!r}")
+    model, state = init_crowd(s, c, g, n_characters=characters, seed=seed, weights=weights, timing=timing,
+                              lod_mode=lod)
+    recorder = Recorder(model, state, frames) if record else None
+    with Progress(TextColumn("simulating"), BarColumn(), TextColumn("{task.completed}/{task.total} frames"),
+                  TimeRemainingColumn(), console=_err(), transient=True, disable=json_out) as bar:
+        task = bar.add_task("frames", total=frames)
+        summary = simulate(model, state, frames, recorder, progress=lambda k: bar.update(task, completed=k))
+    if record:
+        recorder.save(record, model, summary, {"scenario": s.name, "seed": seed, "lod": lod, "gait": g.name})
+    if json_out:
+        print(json.dumps(summary.to_json()))
+        return
+    out = _stdout()
+    table = Table(title=f"{summary.characters} x {c.name} on {s.name}, {frames} frames, LOD {lod}")
+    table.add_column("metric")
+    table.add_column("value", justify="right")
+    for key, value in summary.to_json().items():
+        if key == "stage_ms_median":
+            value = ", ".join(f"{k} {v:.2f}" for k, v in value.items())
+        elif isinstance(value, float):
+            value = f"{value:.4g}"
+        table.add_row(key, str(value))
+    out.print(table)
+    if record:
+        out.print(f"recording: {record}")
+
+
+@bench_app.command("crowd")
+def bench_crowd_cmd(
+    characters: Optional[int] = typer.Option(None, min=1, help="One crowd size (default: 100 and 1000)"),
+    frames: int = typer.Option(60, min=1, help="Measured frames per run"),
+    json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),
+) -> None:
+    """The paper's Table 1: ms per frame, maps preparation, CCD IK and FPS per LOD mode."""
+    from benchmarks.crowd_bench import run
+
+    sizes = (characters,) if characters else (100, 1000)
+    with _err().status("benchmarking crowds...") as status:
+        result = run(sizes=sizes, frames=frames, progress=lambda m: status.update(f"benchmarking {m}"))
+    if json_out:
+        print(json.dumps(result))
+        return
+    out = _stdout()
+    for n, modes in result.items():
+        table = Table(title=f"{n} spiders on mixed (median ms per frame)")
+        for col in ("LOD", "total for characters", "maps preparation", "planning", "CCD IK", "average FPS"):
+            table.add_column(col, justify="right")
+        for mode, row in modes.items():
+            table.add_row(mode, f"{row['ms_per_frame']:.2f}", f"{row['maps_ms']:.2f}", f"{row['plan_ms']:.2f}",
+                          f"{row['ik_ms']:.2f}", f"{row['fps']:.0f}")
+        out.print(table)
+    out.print("paper (2012, 100 spiders): LOD 26 ms, LOD zoomed 28 ms, no LOD 45 ms per frame")
+
+
 @bench_app.command("planner")
 def bench_planner_cmd(
     json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planner._kernels_batch import plan_feet_serial
+from planner._kernels_batch import plan_feet_parallel, plan_feet_serial
 from planner._kernels_foot import N_COUNTERS, N_RAW
 from planner._maps import LocalMaps
 from planner._params import DEFAULT_BUDGET, PlannerConfig, SearchBudget
@@ -96,8 +96,8 @@ def make_batch(maps: list[LocalMaps], requests: list[tuple[int, FootQuery]],
 
 
 def plan_batch(batch: FootBatch, weights: ScoringWeights | None = None, config: PlannerConfig | None = None,
-               mode: str = "search") -> BatchResult:
-    """Plan every foot of ``batch`` in one kernel call."""
+               mode: str = "search", parallel: bool = False) -> BatchResult:
+    """Plan every foot of ``batch`` in one kernel call (``parallel``: over the cores; same results)."""
     weights = weights or ScoringWeights()
     config = config or PlannerConfig()
     n = batch.n_feet
@@ -106,7 +106,8 @@ def plan_batch(batch: FootBatch, weights: ScoringWeights | None = None, config: 
         valid=np.zeros(n, dtype=np.bool_), target=np.zeros((n, 3)), slice_index=np.zeros(n, dtype=np.int64),
         slice_level=np.zeros(n), scores=np.zeros((n, 3)), terms=np.zeros((n, N_TERMS)), raw=np.zeros((n, N_RAW)),
         counters=np.zeros((n, N_COUNTERS), dtype=np.int64), trajectory=np.zeros((n, k, 3)))
-    plan_feet_serial(batch.elevation, batch.ground, batch.forbidden, batch.origins, batch.foot_char, batch.foot_shape,
+    kernel = plan_feet_parallel if parallel else plan_feet_serial
+    kernel(batch.elevation, batch.ground, batch.forbidden, batch.origins, batch.foot_char, batch.foot_shape,
                      batch.sources, batch.preferred, batch.hips, batch.reach_xz, batch.step_height, batch.legs,
                      batch.legs_start, batch.block_radius, weights.to_array(), config.to_array(),
                      batch.couples_after_first, batch.slice_size, batch.early, MODES[mode], out.valid, out.target,

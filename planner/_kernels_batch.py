@@ -45,3 +45,16 @@ def plan_feet_serial(elevation, ground, forbidden, origins, foot_char, foot_shap
                       reach_xz, step_height, legs, legs_start, block_radius, w, cfg, couples_after_first, slice_size,
                       early, mode, out_valid, out_target, out_slice, out_level, out_scores, out_terms, out_raw,
                       out_counters, out_traj)
+
+
+@nb.njit(cache=True, parallel=True)
+def plan_feet_parallel(elevation, ground, forbidden, origins, foot_char, foot_shape, sources, preferred, hips,
+                       reach_xz, step_height, legs, legs_start, block_radius, w, cfg, couples_after_first, slice_size,
+                       early, mode, out_valid, out_target, out_slice, out_level, out_scores, out_terms, out_raw,
+                       out_counters, out_traj):
+    """Same as :func:`plan_feet_serial`, feet spread over the cores (results identical)."""
+    for i in nb.prange(foot_char.size):
+        plan_one_into(i, elevation, ground, forbidden, origins, foot_char, foot_shape, sources, preferred, hips,
+                      reach_xz, step_height, legs, legs_start, block_radius, w, cfg, couples_after_first, slice_size,
+                      early, mode, out_valid, out_target, out_slice, out_level, out_scores, out_terms, out_raw,
+                      out_counters, out_traj)

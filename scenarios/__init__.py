@@ -12,6 +12,14 @@ formats are described in ``scenarios/README.md``.
 
 from scenarios._creatures import Creature
 from scenarios._files import builtin_creature_names, builtin_scenario_names, load_creature, load_scenario
+from scenarios._gaits import (
+    Gait,
+    builtin_gait_names,
+    default_gait_name,
+    load_gait,
+    min_stance_feet,
+    required_stance_feet,
+)
 from scenarios._generators import (
     CrateRecipe,
     flat_heightfield,
@@ -32,15 +40,21 @@ __all__ = [
     "CrateRecipe",
     "Creature",
     "CrowdSpawn",
+    "Gait",
     "Heightfield",
     "Obstacles",
     "Scenario",
     "builtin_creature_names",
+    "builtin_gait_names",
     "builtin_scenario_names",
+    "default_gait_name",
     "flat_heightfield",
     "hills_heightfield",
     "load_creature",
+    "load_gait",
     "load_scenario",
+    "min_stance_feet",
     "random_crates",
+    "required_stance_feet",
     "stairs_heightfield",
 ]

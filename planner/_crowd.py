@@ -1,0 +1,589 @@
+"""Crowd simulation: the character controller of every character, batched (paper §3, §6, §7).
+
+Static model vs changing state, as in MJX/brax: :class:`CrowdModel` holds what does
+not change during a run (creature, gait, weights, world raster, LOD settings);
+:class:`CrowdState` holds every character's state in arrays (C characters x L legs).
+:func:`step` advances the state by one fixed time step (1/30 s); its stages are
+batched over all characters (numpy or numba kernels), never a Python loop over
+characters.
+
+Stages of a frame (timed one by one):
+1. ``steer``: pelvis speed and heading toward the next waypoint, pushed away from
+   forbidden boxes ahead, moved on the ground plane; feet feedback (§3.2, Fig. 7).
+2. ``gait``: the needle advances; feet whose swing sector starts enter swing (§3.3).
+3. ``swing``: swinging feet move along their trajectories at constant speed; landings.
+4. ``requests``: feet to plan: new swings; swinging feet to re-plan (turn, speed
+   change, trajectory invalidated by a moving box); stance feet out of reach or
+   about to be hit by a moving box (they step away).
+5. ``maps``: local maps of the characters that plan this frame (one kernel).
+6. ``plan``: every request in one kernel call (numba prange over the cores), each
+   with its character's LOD budget; a foot with no valid couple holds (stays in
+   stance and asks again next frame).
+7. ``pelvis``: height, pitch and roll from convex hulls over the ground and feet.
+8. ``ik``: CCD for every leg of every character that needs it (LOD: not off-screen).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from planner._batch import FootBatch, plan_batch
+from planner._kernels_body import pelvis_from_hulls
+from planner._kernels_controller import (
+    advance_swings,
+    count_collisions,
+    count_forbidden_landings,
+    count_leg_crossings,
+    stance_threatened,
+    swings_invalidated,
+)
+from planner._kernels_maps import build_local_maps
+from planner._lod import FULL_SEARCH, LodConfig, frame_crowd, lod_budgets, look_at, visibility
+from planner._maps import WorldRaster
+from planner._params import PlannerConfig
+from planner._weights import ScoringWeights
+
+DT = 1.0 / 30.0
+STAGES = ("steer", "gait", "swing", "requests", "maps", "plan", "pelvis", "ik")
+
+
+@dataclass(frozen=True)
+class ControllerConfig:
+    """Character controller settings (units per field).
+
+    Tuning guide: ``turn_rate`` limits how fast a heading changes; ``replan_heading``
+    and ``replan_speed`` are the turn (rad) and relative speed change after which a
+    swinging foot re-plans (§3.2); ``feedback_threshold`` (fraction of the rest
+    radius) is when the mean offset between preferred and chosen footprints is
+    'significant' and moves the pelvis, at ``feedback_gain`` per second.
+    """
+
+    turn_rate: float = 1.5  # rad/s
+    acceleration: float = 1.0  # m/s^2
+    arrive_radius: float = 0.3  # m
+    avoid_margin: float = 0.35  # m beyond the rest radius where forbidden boxes push the heading
+    replan_heading: float = 0.2  # rad
+    replan_speed: float = 0.25  # relative
+    feedback_threshold: float = 0.15  # x rest radius
+    feedback_gain: float = 2.0  # 1/s
+    step_height_factor: float = 0.3  # x standing height
+    reach_margin: float = 0.95  # stance feet beyond this fraction of the reach step
+    threat_margin: float = 0.04  # m, a moving box this close to a stance foot makes it step
+    bob_factor: float = 0.2  # x body thickness, pelvis bobbing amplitude
+
+
+def _rot_xz(heading, forward, lateral):
+    c = np.cos(heading)
+    s = np.sin(heading)
+    return forward * c - lateral * s, forward * s + lateral * c
+
+
+@dataclass(frozen=True)
+class CrowdModel:
+    creature: object
+    gait: object
+    timing: object
+    weights: ScoringWeights
+    config: PlannerConfig
+    controller: ControllerConfig
+    lod: LodConfig
+    lod_mode: str
+    raster: WorldRaster
+    camera: object  # scenarios.Camera (used by lod_mode 'on' only as the look direction hint)
+    dt: float
+    feet_spacing: float
+    hips_body: np.ndarray  # (L, 3) forward, up, lateral
+    rest_body: np.ndarray  # (L, 2) forward, lateral (scaled by feet_spacing)
+    reach: np.ndarray  # (L,) leg reach, m
+    leg_static: object  # IK statics (planner._ik)
+
+    @property
+    def n_legs(self) -> int:
+        return int(self.hips_body.shape[0])
+
+    @property
+    def leg_height(self) -> float:
+        """h of the Froude number: the mean hip height when standing, m."""
+        from planner._timing import hip_height
+
+        return hip_height(self.creature)
+
+    @property
+    def rest_radius(self) -> float:
+        return float(np.max(np.hypot(self.rest_body[:, 0], self.rest_body[:, 1])))
+
+
+@dataclass
+class CrowdState:
+    t: float
+    frame: int
+    pelvis: np.ndarray  # (C, 3)
+    heading: np.ndarray  # (C,)
+    pitch: np.ndarray
+    roll: np.ndarray
+    speed: np.ndarray
+    desired_speed: np.ndarray
+    route: np.ndarray  # (C, R, 2)
+    route_index: np.ndarray  # (C,)
+    feedback: np.ndarray  # (C, 2) mean chosen - preferred offset, EMA
+    feet: np.ndarray  # (C, L, 3)
+    in_stance: np.ndarray  # (C, L) bool
+    wants_swing: np.ndarray  # (C, L) bool: the gait asked for a swing not yet planned
+    swing_t: np.ndarray
+    swing_T: np.ndarray
+    trajectories: np.ndarray  # (C, L, K, 3)
+    swing_target: np.ndarray  # (C, L, 3)
+    plan_heading: np.ndarray  # (C, L)
+    plan_speed: np.ndarray
+    foot_yaws: np.ndarray  # (C, L)
+    gaits: object  # planner._gait.GaitManagerState
+    angles: np.ndarray  # (C, L, S + 1)
+    residual: np.ndarray  # (C, L)
+    ik_on: np.ndarray  # (C,) bool, IK solved this frame
+    fk_feet: np.ndarray  # (C, L, 3) feet where the IK put them
+    hull: np.ndarray  # (C,)
+    counters: dict = field(default_factory=dict)
+    last_plans: object = None  # (chars, legs, kinds, BatchResult) of the last frame, for recordings
+
+
+def hips_world(model: CrowdModel, state: CrowdState) -> np.ndarray:
+    """(C, L, 3) hip positions: body-frame hips rotated by heading, pitch and roll
+    (the rotation of :func:`planner._ik.body_rotation`)."""
+    from planner._ik import body_rotation
+
+    rotation = body_rotation(state.heading, state.pitch, state.roll)  # (C, 3, 3), columns forward, up, left
+    return state.pelvis[:, None, :] + np.einsum("cij,lj->cli", rotation, model.hips_body)
+
+
+def _boxes_now(model: CrowdModel, t: float):
+    obs = model.raster.obstacles
+    if len(obs.yaws) == 0:
+        z3 = np.zeros((0, 3))
+        return z3, z3, np.zeros(0), np.zeros(0, np.bool_), np.zeros(0, np.bool_)
+    centres, yaws = obs.poses_at(t)
+    return (np.ascontiguousarray(centres, dtype=np.float64), np.ascontiguousarray(obs.sizes, dtype=np.float64),
+            np.ascontiguousarray(yaws, dtype=np.float64), np.ascontiguousarray(obs.forbidden, dtype=np.bool_),
+            np.ascontiguousarray(~np.asarray(obs.is_static), dtype=np.bool_))
+
+
+def _wrap(a):
+    return (a + np.pi) % (2.0 * np.pi) - np.pi
+
+
+# ----------------------------------------------------------------------------- stages
+def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
+    ctl = model.controller
+    dt = model.dt
+    n = state.pelvis.shape[0]
+    rows = np.arange(n)
+    last = state.route.shape[1] - 1
+    target = state.route[rows, state.route_index]
+    d = target - state.pelvis[:, [0, 2]]
+    dist = np.hypot(d[:, 0], d[:, 1])
+    advance = (dist < ctl.arrive_radius) & (state.route_index < last)
+    if advance.any():
+        state.route_index[advance] += 1
+        target = state.route[rows, state.route_index]
+        d = target - state.pelvis[:, [0, 2]]
+        dist = np.hypot(d[:, 0], d[:, 1])
+    arrived = (dist < ctl.arrive_radius) & (state.route_index == last)
+    direction = d / np.maximum(dist, 1e-9)[:, None]
+    centres, sizes, yaws, forbidden, _ = boxes
+    if forbidden.any():
+        bc = centres[forbidden][:, [0, 2]]
+        br = 0.5 * np.hypot(sizes[forbidden, 0], sizes[forbidden, 2])
+        rel = state.pelvis[:, None, [0, 2]] - bc[None, :, :]  # (C, B, 2) box -> pelvis
+        rn = np.maximum(np.hypot(rel[..., 0], rel[..., 1]), 1e-9)
+        gap = rn - br[None, :] - model.rest_radius
+        weight = np.clip(1.0 - gap / ctl.avoid_margin, 0.0, 1.0) ** 2
+        ahead = (-(rel[..., 0] * direction[:, None, 0] + rel[..., 1] * direction[:, None, 1]) / rn) > -0.2
+        push = ((weight * ahead)[..., None] * rel / rn[..., None]).sum(axis=1)
+        direction = direction + 1.5 * push
+        direction /= np.maximum(np.hypot(direction[:, 0], direction[:, 1]), 1e-9)[:, None]
+    desired = np.arctan2(direction[:, 1], direction[:, 0])
+    turn = _wrap(desired - state.heading)
+    state.heading = _wrap(state.heading + np.clip(turn, -ctl.turn_rate * dt, ctl.turn_rate * dt))
+    v_des = np.where(arrived, 0.0, state.desired_speed * np.maximum(0.3, np.cos(np.clip(turn, -np.pi / 2, np.pi / 2))))
+    state.speed = state.speed + np.clip(v_des - state.speed, -ctl.acceleration * dt, ctl.acceleration * dt)
+    fwd = np.stack([np.cos(state.heading), np.sin(state.heading)], axis=1)
+    state.pelvis[:, [0, 2]] += fwd * (state.speed * dt)[:, None]
+    # Feet feedback (§3.2): a significant mean offset between preferred and chosen footprints moves the pelvis.
+    fb = state.feedback
+    significant = np.hypot(fb[:, 0], fb[:, 1]) > ctl.feedback_threshold * model.rest_radius
+    if significant.any():
+        move = fb[significant] * min(1.0, ctl.feedback_gain * dt)
+        idx = np.flatnonzero(significant)
+        state.pelvis[idx, 0] += move[:, 0]
+        state.pelvis[idx, 2] += move[:, 1]
+        fb[idx] -= move
+
+
+def stage_gait(model: CrowdModel, state: CrowdState):
+    """Stride frequency and duty factor from the speed (the destination disks follow the
+    duty factor, the disks in use move toward them while in stance), then the needle."""
+    from planner._gait import advance, set_speed
+
+    frequency = set_speed(state.gaits, model.timing, state.speed, model.leg_height)
+    enter, fraction = advance(state.gaits, frequency, model.dt, state.in_stance)
+    return frequency, enter, fraction
+
+
+def stage_swing(model: CrowdModel, state: CrowdState, boxes) -> np.ndarray:
+    landed = np.zeros(state.in_stance.shape, dtype=np.bool_)
+    advance_swings(state.swing_t, state.swing_T, state.trajectories, state.in_stance, state.feet, model.dt, landed)
+    if landed.any():
+        state.in_stance |= landed
+        state.counters["steps"] += int(landed.sum())
+        centres, sizes, yaws, forbidden, _ = boxes
+        state.counters["forbidden_footprints"] += count_forbidden_landings(
+            landed, state.feet, 0.5 * model.creature.foot_length, 0.5 * model.creature.foot_width, state.foot_yaws,
+            centres, sizes, yaws, forbidden)
+    return landed
+
+
+def _reach_xz(model: CrowdModel) -> np.ndarray:
+    reach = model.controller.reach_margin * model.reach
+    dy = model.creature.standing_height + model.hips_body[:, 1]
+    return np.sqrt(np.maximum(reach**2 - dy**2, (0.2 * reach) ** 2))
+
+
+def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips) -> np.ndarray:
+    """(C, L) int8 request kinds: 0 none, 1 new swing, 2 forced step, 3 re-plan."""
+    ctl = model.controller
+    state.wants_swing |= enter & state.in_stance
+    kinds = np.zeros(state.in_stance.shape, dtype=np.int8)
+    kinds[state.wants_swing & state.in_stance] = 1
+    far = np.hypot(state.feet[..., 0] - hips[..., 0], state.feet[..., 2] - hips[..., 2]) > _reach_xz(model)[None, :]
+    centres, sizes, yaws, forbidden, moving = boxes
+    threatened = np.zeros(state.in_stance.shape, dtype=np.bool_)
+    invalid = np.zeros(state.in_stance.shape, dtype=np.bool_)
+    if moving.any():
+        stance_threatened(state.in_stance, state.feet, 0.5 * model.creature.foot_length,
+                          0.5 * model.creature.foot_width, state.foot_yaws, ctl.threat_margin, centres, sizes, yaws,
+                          forbidden, moving, threatened)
+        swings_invalidated(state.in_stance, state.swing_t, state.swing_T, state.trajectories,
+                           0.5 * model.creature.foot_length, 0.5 * model.creature.foot_width, state.foot_yaws,
+                           centres, sizes, yaws, forbidden, moving, 2.0 * model.rest_radius + 1.0, invalid)
+    forced = state.in_stance & (far | threatened) & (kinds == 0)
+    kinds[forced] = 2
+    swinging = ~state.in_stance
+    turned = np.abs(_wrap(state.heading[:, None] - state.plan_heading)) > ctl.replan_heading
+    sped = np.abs(state.speed[:, None] - state.plan_speed) > ctl.replan_speed * np.maximum(state.plan_speed, 0.05)
+    kinds[swinging & (turned | sped | invalid)] = 3
+    # A foot never lifts while its neighbours in the gait would leave too few feet on the ground:
+    # forced steps wait while more than half the legs swing.
+    too_many = (~state.in_stance).sum(axis=1) >= max(1, model.n_legs // 2)
+    kinds[(kinds == 2) & too_many[:, None]] = 0
+    return kinds
+
+
+def character_budgets(model: CrowdModel, state: CrowdState):
+    """(couples_after_first (C,), slice_size (C,), on_screen (C,)) from the LOD mode and camera."""
+    n = state.pelvis.shape[0]
+    if model.lod_mode == "off":
+        c, s, _ = FULL_SEARCH.kernel_args()
+        return np.full(n, c, np.int64), np.full(n, s), np.ones(n, np.bool_)
+    fov = float(model.camera.fov)
+    if model.lod_mode == "on":
+        camera = frame_crowd(state.pelvis, fov, fraction=1.0)
+    else:
+        camera = frame_crowd(state.pelvis, fov, fraction=0.5, focus=0)
+    on_screen, distance = visibility(camera, state.pelvis)
+    couples, slices = lod_budgets(on_screen, distance, model.lod)
+    return couples, slices, on_screen
+
+
+def stage_maps(model: CrowdModel, state: CrowdState, chars: np.ndarray, boxes):
+    r = model.raster
+    n = model.config.map_cells
+    k = chars.size
+    elev = np.empty((k, n, n))
+    ground = np.empty((k, n, n))
+    forb = np.empty((k, n, n), dtype=np.uint8)
+    origin = np.empty((k, 2))
+    centres, sizes, yaws, forbidden, moving = boxes
+    build_local_maps(r.ground, r.static_top, r.static_forbidden, r.frame.origin_x, r.frame.origin_z,
+                     r.frame.cell_size, np.ascontiguousarray(state.pelvis[chars][:, [0, 2]]), centres, sizes, yaws,
+                     forbidden, moving, elev, ground, forb, origin)
+    return elev, ground, forb, origin
+
+
+def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, maps, chars, hips):
+    """Plan every request in one kernel call; apply the results. Returns the batch result."""
+    cs, ls = np.nonzero(kinds)
+    f = cs.size
+    n_legs = model.n_legs
+    map_of = np.full(state.pelvis.shape[0], -1, np.int64)
+    map_of[chars] = np.arange(chars.size)
+    freq = np.maximum(frequency[cs], 1e-3)
+    durations = np.asarray(state.gaits.disk_duration)[cs, ls]
+    new = kinds[cs, ls] != 3
+    t_swing = np.where(new, np.minimum(durations / freq, 1.0),
+                       np.maximum(state.swing_T[cs, ls] - state.swing_t[cs, ls], 2.0 * model.dt))
+    duty = state.gaits.duty_factor[cs]
+    t_stance = np.where(np.isfinite(duty), duty, 1.0 - durations) / freq
+    heading = state.heading[cs]
+    fwd = np.stack([np.cos(heading), np.sin(heading)], axis=1)
+    v = state.speed[cs]
+    pred = state.pelvis[cs][:, [0, 2]] + fwd * (v * t_swing)[:, None]
+    rx, rz = _rot_xz(heading, model.rest_body[ls, 0], model.rest_body[ls, 1])
+    preferred = pred + np.stack([rx, rz], axis=1) + fwd * (0.5 * v * t_stance)[:, None]
+    hx, hz = _rot_xz(heading, model.hips_body[ls, 0], model.hips_body[ls, 2])
+    hip_pred = pred + np.stack([hx, hz], axis=1)
+    foot_yaw = np.arctan2(preferred[:, 1] - hip_pred[:, 1], preferred[:, 0] - hip_pred[:, 0])
+    # The other legs at touchdown time: their hips carried forward with the pelvis, their feet
+    # where they stand (or will land). Mixing predicted and current hips would make legs
+    # 'cross' at the hips.
+    support = np.where(state.in_stance[..., None], state.feet, state.swing_target)
+    others = np.array([[j for j in range(n_legs) if j != i] for i in range(n_legs)], dtype=np.int64)
+    oj = others[ls]  # (F, L-1)
+    shift = pred - state.pelvis[cs][:, [0, 2]]
+    legs = np.stack([hips[cs[:, None], oj, 0] + shift[:, None, 0], hips[cs[:, None], oj, 2] + shift[:, None, 1],
+                     support[cs[:, None], oj, 0], support[cs[:, None], oj, 2]], axis=-1).reshape(-1, 4)
+    couples, slices, _ = budgets
+    elev, ground, forb, origin = maps
+    batch = FootBatch(
+        elevation=elev, ground=ground, forbidden=forb, origins=origin, foot_char=map_of[cs],
+        foot_shape=np.stack([np.full(f, model.creature.foot_length), np.full(f, model.creature.foot_width), foot_yaw],
+                            axis=1),
+        sources=np.ascontiguousarray(state.feet[cs, ls]), preferred=np.ascontiguousarray(preferred),
+        hips=np.ascontiguousarray(hip_pred), reach_xz=_reach_xz(model)[ls],
+        step_height=np.full(f, model.controller.step_height_factor * model.creature.standing_height),
+        legs=np.ascontiguousarray(legs), legs_start=np.arange(f + 1, dtype=np.int64) * (n_legs - 1),
+        block_radius=np.full(f, math.hypot(model.creature.foot_length, model.creature.foot_width)),
+        couples_after_first=couples[cs], slice_size=slices[cs], early=np.ones(f, np.bool_))
+    out = plan_batch(batch, model.weights, model.config, parallel=True)
+    ok = out.valid
+    vc, vl = cs[ok], ls[ok]
+    state.trajectories[vc, vl] = out.trajectory[ok]
+    state.swing_t[vc, vl] = 0.0
+    state.swing_T[vc, vl] = t_swing[ok]
+    state.swing_target[vc, vl] = out.target[ok]
+    state.in_stance[vc, vl] = False
+    state.wants_swing[vc, vl] = False
+    state.plan_heading[vc, vl] = heading[ok]
+    state.plan_speed[vc, vl] = v[ok]
+    state.foot_yaws[vc, vl] = foot_yaw[ok]
+    fresh = ok & new
+    if fresh.any():
+        offset = out.target[fresh][:, [0, 2]] - preferred[fresh]
+        np.add.at(state.feedback, cs[fresh], 0.3 * (offset - state.feedback[cs[fresh]]))
+    state.counters["plans"] += int(f)
+    state.counters["holds"] += int((~ok & new).sum())
+    state.counters["replans"] += int((kinds[cs, ls] == 3).sum())
+    state.counters["cells_expanded"] += int(out.counters[:, 2].sum())
+    state.counters["couples_evaluated"] += int(out.counters[:, 0].sum())
+    return batch, out, cs, ls
+
+
+def stage_pelvis(model: CrowdModel, state: CrowdState) -> None:
+    r = model.raster
+    support = np.ascontiguousarray(np.where(state.in_stance[..., None], state.feet, state.swing_target))
+    bob = model.controller.bob_factor * model.creature.body_thickness * np.sin(4.0 * np.pi * state.gaits.needle)
+    y = np.empty(state.pelvis.shape[0])
+    pelvis_from_hulls(r.static_top, r.frame.origin_x, r.frame.origin_z, r.frame.cell_size, state.pelvis,
+                      state.heading, support, float(model.creature.body_box[0]), float(model.creature.body_box[1]),
+                      float(model.creature.standing_height), bob, y, state.pitch, state.roll, state.hull)
+    state.pelvis[:, 1] = y
+
+
+def stage_ik(model: CrowdModel, state: CrowdState, on_screen: np.ndarray) -> None:
+    """CCD for every leg of the characters that need it, in one kernel call (warm start:
+    the previous frame's angles)."""
+    from planner._ik import body_rotation, solve_legs
+
+    chars = np.flatnonzero(on_screen)
+    state.ik_on[:] = False
+    if chars.size == 0:
+        return
+    legs = model.leg_static
+    n, L = chars.size, model.n_legs
+    s = legs.segment_lengths.shape[1]
+    rotation = np.repeat(body_rotation(state.heading[chars], state.pitch[chars], state.roll[chars]), L, axis=0)
+    res = solve_legs(hips_world(model, state)[chars].reshape(n * L, 3), rotation, np.tile(legs.rest_azimuths, n),
+                     np.tile(legs.segment_lengths, (n, 1)), np.tile(legs.limits, (n, 1, 1)),
+                     np.tile(legs.azimuth_limits, n), state.feet[chars].reshape(n * L, 3),
+                     warm_start=state.angles[chars].reshape(n * L, s + 1))
+    state.angles[chars] = res.angles.reshape(n, L, s + 1)
+    state.residual[chars] = res.residual.reshape(n, L)
+    state.fk_feet[chars] = res.feet.reshape(n, L, 3)
+    state.ik_on[chars] = True
+
+
+# ----------------------------------------------------------------------------- set-up
+def spawn_positions(scenario, creature, n: int, spacing_factor: float = 1.5):
+    """n start positions (x, z) on a sunflower spiral around the crowd centre, clear of boxes.
+
+    Creatures are ``spacing_factor`` x their rest radius apart; when the world is too
+    small the spacing shrinks (down to one rest radius: legs interleave). Raises
+    ``InputError`` when even that does not fit.
+    """
+    from footfall._errors import InputError
+
+    rest = float(creature.rest_radius)
+    obs = scenario.obstacles
+    centres, _ = obs.poses_at(0.0)
+    box_r = 0.5 * np.hypot(obs.sizes[:, 0], obs.sizes[:, 2]) if len(obs.yaws) else np.zeros(0)
+    x0, x1 = scenario.terrain.x_range
+    z0, z1 = scenario.terrain.z_range
+    golden = math.pi * (3.0 - math.sqrt(5.0))
+    for factor in (spacing_factor, 1.25, 1.0):
+        spacing = factor * rest
+        m = 4 * n + 64
+        k = np.arange(m)
+        r = spacing * np.sqrt(k / math.pi)  # sunflower spiral: neighbours about `spacing` apart
+        a = k * golden
+        pts = scenario.crowd.centre[None, :] + np.stack([r * np.cos(a), r * np.sin(a)], axis=1)
+        inside = (pts[:, 0] > x0 + rest + 0.5) & (pts[:, 0] < x1 - rest - 0.5) & (pts[:, 1] > z0 + rest + 0.5) & (
+            pts[:, 1] < z1 - rest - 0.5)
+        clear = np.ones(m, np.bool_)
+        if len(box_r):
+            d = np.hypot(pts[:, None, 0] - centres[None, :, 0], pts[:, None, 1] - centres[None, :, 2])
+            clear = (d > box_r[None, :] + rest + 0.1).all(axis=1)
+        ok = np.flatnonzero(inside & clear)
+        if ok.size >= n:
+            return pts[ok[:n]]
+    raise InputError(scenario.source, "crowd.count", f"no room for {n} x {creature.name} clear of the obstacles")
+
+
+def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, seed: int = 0,
+               weights: ScoringWeights | None = None, timing=None, lod_mode: str = "off",
+               config: PlannerConfig | None = None, controller: ControllerConfig | None = None,
+               lod: LodConfig | None = None, raster: WorldRaster | None = None) -> tuple[CrowdModel, CrowdState]:
+    """Build the static model and the initial state of a crowd (validated before any frame)."""
+    from footfall._errors import InputError
+    from planner._gait import init_gaits
+    from planner._ik import legs_of, rest_pose_angles
+    from planner._timing import GaitTiming
+
+    if lod_mode not in ("on", "zoomed", "off"):
+        raise InputError("argument", "--lod", f"expected on, zoomed or off, got {lod_mode!r}")
+    config = config or PlannerConfig()
+    controller = controller or ControllerConfig()
+    weights = weights or ScoringWeights()
+    timing = timing or GaitTiming()
+    lod = lod or LodConfig()
+    n = int(n_characters or scenario.crowd.count)
+    if n < 1:
+        raise InputError("argument", "--characters", "expected at least 1 character")
+    if creature.n_legs < 1:
+        raise InputError(creature.name, "legs", "a creature needs at least one leg")
+    map_half = 0.5 * config.map_cells * config.cell_size
+    span = float(creature.rest_radius) + config.search_radius_m + float(np.max(creature.leg_reach))
+    if span + (config.roi_margin_cells + 2) * config.cell_size > map_half:
+        raise InputError(creature.name, "legs", f"the creature (reach {span:.2f} m) is too large for its "
+                         f"{config.map_cells} x {config.map_cells} local map of {config.cell_size} m cells")
+    speed = float(scenario.crowd.speed)
+    from planner._timing import stride_length
+
+    reach = 0.95 * float(np.min(creature.leg_reach))
+    stride = float(stride_length(timing, np.array([speed]), float(creature.standing_height))[0])
+    if stride > 2.0 * reach:
+        raise InputError(scenario.source, "crowd.speed", f"{speed} m/s needs strides of {stride:.2f} m, beyond "
+                         f"what legs of reach {reach:.2f} m can take")
+    raster = raster or WorldRaster.build(scenario.terrain, scenario.obstacles, config.cell_size)
+    spacing = float(scenario.crowd.feet_spacing)
+    model = CrowdModel(
+        creature=creature, gait=gait, timing=timing, weights=weights, config=config, controller=controller, lod=lod,
+        lod_mode=lod_mode, raster=raster, camera=scenario.camera, dt=DT, feet_spacing=spacing,
+        hips_body=np.asarray(creature.hips, dtype=np.float64),
+        rest_body=spacing * np.asarray(creature.rest_feet, dtype=np.float64),
+        reach=np.asarray(creature.leg_reach, dtype=np.float64), leg_static=legs_of(creature))
+    rng = np.random.default_rng(seed)
+    positions = spawn_positions(scenario, creature, n)
+    if scenario.crowd.heading_mode == "random":
+        headings = rng.uniform(-math.pi, math.pi, n)
+    else:
+        headings = np.full(n, float(scenario.crowd.heading))
+    route = np.asarray(scenario.crowd.route, dtype=np.float64)
+    offsets = positions - scenario.crowd.centre[None, :]
+    x0, x1 = scenario.terrain.x_range
+    z0, z1 = scenario.terrain.z_range
+    routes = route[None, :, :] + offsets[:, None, :]
+    routes[..., 0] = np.clip(routes[..., 0], x0 + 1.0, x1 - 1.0)
+    routes[..., 1] = np.clip(routes[..., 1], z0 + 1.0, z1 - 1.0)
+    L = creature.n_legs
+    K = config.trajectory_samples
+    feet = _initial_feet(model, positions, headings)
+    ground = raster.ground
+    gr, gc = raster.frame.world_to_cell(positions[:, 0], positions[:, 1])
+    pelvis = np.column_stack([positions[:, 0], ground[np.clip(gr, 0, ground.shape[0] - 1),
+                                                      np.clip(gc, 0, ground.shape[1] - 1)]
+                              + creature.standing_height, positions[:, 1]])
+    hx, hz = _rot_xz(headings[:, None], model.hips_body[None, :, 0], model.hips_body[None, :, 2])
+    yaws = np.arctan2(feet[..., 2] - (pelvis[:, None, 2] + hz), feet[..., 0] - (pelvis[:, None, 0] + hx))
+    angles = np.repeat(rest_pose_angles(creature)[None], n, axis=0)
+    state = CrowdState(
+        t=0.0, frame=0, pelvis=pelvis, heading=headings.copy(), pitch=np.zeros(n), roll=np.zeros(n),
+        speed=np.zeros(n), desired_speed=np.full(n, speed), route=routes, route_index=np.zeros(n, np.int64),
+        feedback=np.zeros((n, 2)), feet=feet, in_stance=np.ones((n, L), np.bool_),
+        wants_swing=np.zeros((n, L), np.bool_), swing_t=np.zeros((n, L)), swing_T=np.zeros((n, L)),
+        trajectories=np.repeat(feet[:, :, None, :], K, axis=2), swing_target=feet.copy(),
+        plan_heading=np.repeat(headings[:, None], L, axis=1), plan_speed=np.zeros((n, L)), foot_yaws=yaws,
+        gaits=init_gaits([gait] * n, n, rng.uniform(0.0, 1.0, n)), angles=angles, residual=np.zeros((n, L)),
+        ik_on=np.zeros(n, np.bool_), fk_feet=feet.copy(), hull=np.zeros(n),
+        counters={k: 0 for k in ("steps", "plans", "holds", "replans", "forbidden_footprints", "cells_expanded",
+                                 "couples_evaluated")})
+    stage_pelvis(model, state)
+    return model, state
+
+
+def _initial_feet(model: CrowdModel, positions, headings):
+    """Rest feet on cell centres of the world raster, resting on the highest point under the foot."""
+    r = model.raster
+    fx, fz = _rot_xz(headings[:, None], model.rest_body[None, :, 0], model.rest_body[None, :, 1])
+    fx = fx + positions[:, None, 0]
+    fz = fz + positions[:, None, 1]
+    rows, cols = r.frame.world_to_cell(fx, fz)
+    rows = np.clip(rows, 1, r.frame.n_rows - 2)
+    cols = np.clip(cols, 1, r.frame.n_cols - 2)
+    cx, cz = r.frame.cell_to_world(rows, cols)
+    top = np.full(rows.shape, -np.inf)
+    for dr in (-1, 0, 1):
+        for dc in (-1, 0, 1):
+            top = np.maximum(top, r.static_top[rows + dr, cols + dc])
+    return np.stack([cx, top, cz], axis=-1)
+
+
+# ----------------------------------------------------------------------------- the frame
+def step(model: CrowdModel, state: CrowdState) -> dict[str, float]:
+    """Advance the crowd by one time step; returns the seconds spent per stage."""
+    timings = {}
+    clock = time.perf_counter
+    state.t += model.dt
+    state.frame += 1
+    boxes = _boxes_now(model, state.t)
+
+    t0 = clock()
+    stage_steer(model, state, boxes)
+    t1 = clock()
+    frequency, enter, _ = stage_gait(model, state)
+    t2 = clock()
+    stage_swing(model, state, boxes)
+    t3 = clock()
+    hips = hips_world(model, state)
+    kinds = stage_requests(model, state, enter, boxes, hips)
+    budgets = character_budgets(model, state)
+    t4 = clock()
+    chars = np.unique(np.nonzero(kinds)[0])
+    if chars.size:
+        maps = stage_maps(model, state, chars, boxes)
+        t5 = clock()
+        _, out, cs, ls = stage_plan(model, state, kinds, frequency, budgets, maps, chars, hips)
+        state.last_plans = (cs, ls, kinds[cs, ls], out)
+    else:
+        t5 = clock()
+        state.last_plans = None
+    t6 = clock()
+    stage_pelvis(model, state)
+    t7 = clock()
+    stage_ik(model, state, budgets[2])
+    t8 = clock()
+    for name, (a, b) in zip(STAGES, ((t0, t1), (t1, t2), (t2, t3), (t3, t4), (t4, t5), (t5, t6), (t6, t7),
+                                      (t7, t8))):
+        timings[name] = b - a
+    return timings

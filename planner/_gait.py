@@ -1,0 +1,327 @@
+"""The gait manager (paper §3.3, Fig. 8-9) for a crowd: C characters x L legs in arrays.
+
+Every character of a :class:`GaitManagerState` has the same number of legs
+(one state per creature kind). Each character has a needle (its phase in the
+stride cycle) and one disk per foot, the swing sector [start, start +
+duration) (mod 1), phases being fractions of a cycle in [0, 1). One numba
+kernel, :func:`planner._kernels_gait.advance_gaits`, steps the whole crowd per
+frame; its doc gives the exact rules (entering a sector, transitions).
+
+Typical frame::
+
+    frequency = set_speed(state, timing, speed, hip_height)      # (C,) Hz; rescales the destination disks
+    enter, fraction = advance(state, frequency, dt, in_stance)   # (C, L) bool, (C, L) float
+
+``enter`` lists the stance feet that must start a swing now (the character
+controller plans their footprints); ``fraction`` is each active foot's
+progress through its sector (0 for feet outside their sector).
+
+Gait changes (:func:`set_destination`) and speed changes (:func:`set_speed`)
+set the *destination* disks; the disks in use move toward them only while
+their foot is in stance, at ``transition_rate`` cycles of phase per second,
+the start along the arc that avoids the destination's finish (Fig. 9).
+
+The state is a plain struct of mutable arrays owned by the simulation; the
+functions here validate their inputs and call the kernels, which write into
+the state in place.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from planner._kernels_gait import active_feet, advance_gaits, retime_gaits
+from planner._timing import GaitTiming, scaled_swing_durations
+
+DEFAULT_TRANSITION_RATE = 0.5
+"""Cycles of phase per second a disk's start moves during a gait transition (a half-cycle shift in 1 s)."""
+
+
+@dataclass(eq=False)
+class GaitManagerState:
+    """Gait manager state of C characters with L legs each (mutable arrays, float64 unless noted).
+
+    Attributes
+    ----------
+    needle:
+        (C,) phase of each character's needle, in [0, 1).
+    disk_start, disk_duration:
+        (C, L) the disks in use: swing sector start in [0, 1) and swing fraction in (0, 1).
+    dest_start, dest_duration:
+        (C, L) the destination disks (equal to the disks in use when not transitioning):
+        ``gait_start`` and ``gait_duration`` scaled to the last duty factor (:func:`set_speed`).
+    transition_rate:
+        (C,) cycles of phase per second a disk moves toward its destination (>= 0).
+    gait_start, gait_duration:
+        (C, L) the destination gait as authored, before speed scaling.
+    duty_factor:
+        (C,) duty factor the destination durations were scaled to; NaN = the gait as authored.
+    leg_names:
+        The legs' names when the gaits came as :class:`scenarios.Gait` values, else ``None``.
+    """
+
+    needle: np.ndarray
+    disk_start: np.ndarray
+    disk_duration: np.ndarray
+    dest_start: np.ndarray
+    dest_duration: np.ndarray
+    transition_rate: np.ndarray
+    gait_start: np.ndarray
+    gait_duration: np.ndarray
+    duty_factor: np.ndarray
+    leg_names: tuple[str, ...] | None = field(default=None)
+
+    @property
+    def n_characters(self) -> int:
+        return self.disk_start.shape[0]
+
+    @property
+    def n_legs(self) -> int:
+        return self.disk_start.shape[1]
+
+    def copy(self) -> "GaitManagerState":
+        """A deep copy (new arrays)."""
+        arrays = {name: getattr(self, name).copy() for name in _ARRAY_FIELDS}
+        return GaitManagerState(**arrays, leg_names=self.leg_names)
+
+    def transitioning(self) -> np.ndarray:
+        """(C,) bool: some disk of the character differs from its destination."""
+        return np.any((self.disk_start != self.dest_start) | (self.disk_duration != self.dest_duration), axis=1)
+
+    def active(self) -> np.ndarray:
+        """(C, L) bool: the needle lies inside the foot's sector (the foot should swing)."""
+        out = np.zeros(self.disk_start.shape, dtype=np.bool_)
+        active_feet(self.needle, self.disk_start, self.disk_duration, out)
+        return out
+
+
+_ARRAY_FIELDS = ("needle", "disk_start", "disk_duration", "dest_start", "dest_duration", "transition_rate",
+                 "gait_start", "gait_duration", "duty_factor")
+
+
+# --------------------------------------------------------------------------- validation helpers
+
+
+def _check_disks(start: np.ndarray, duration: np.ndarray, what: str) -> None:
+    if start.shape[-1] == 0:
+        raise ValueError(f"{what}: a gait needs at least one leg")
+    if not np.all(np.isfinite(start)) or np.any((start < 0.0) | (start >= 1.0)):
+        raise ValueError(f"{what}: swing starts must be phases in [0, 1)")
+    if not np.all(np.isfinite(duration)) or np.any((duration <= 0.0) | (duration >= 1.0)):
+        raise ValueError(f"{what}: swing durations must be in (0, 1)")
+
+
+def _is_gait(value: Any) -> bool:
+    return hasattr(value, "swing_start") and hasattr(value, "swing_duration")
+
+
+def _gait_rows(gaits: Any, n_rows: int, what: str) -> tuple[np.ndarray, np.ndarray, tuple[str, ...] | None]:
+    """(start (n_rows, L), duration (n_rows, L), leg names or None) of one gait, a list of gaits or arrays.
+
+    Accepted: a ``Gait`` (every row), a sequence of ``n_rows`` gaits, or a pair
+    ``(start, duration)`` of (L,) or (n_rows, L) arrays.
+    """
+    names: tuple[str, ...] | None = None
+    if _is_gait(gaits):
+        start, duration = np.asarray(gaits.swing_start, float)[None, :], np.asarray(gaits.swing_duration, float)[None, :]
+        names = tuple(getattr(gaits, "leg_names", ())) or None
+    elif isinstance(gaits, Sequence) and len(gaits) > 0 and all(_is_gait(g) for g in gaits):
+        if len(gaits) != n_rows:
+            raise ValueError(f"{what}: expected one gait or {n_rows} gaits, got {len(gaits)}")
+        lengths = {len(g.swing_start) for g in gaits}
+        if len(lengths) != 1:
+            raise ValueError(f"{what}: the gaits have different numbers of legs {sorted(lengths)}")
+        leg_sets = {tuple(getattr(g, "leg_names", ())) for g in gaits}
+        if len(leg_sets) != 1:
+            raise ValueError(f"{what}: the gaits name different legs (or the same legs in another order)")
+        start = np.array([g.swing_start for g in gaits], dtype=np.float64)
+        duration = np.array([g.swing_duration for g in gaits], dtype=np.float64)
+        names = leg_sets.pop() or None
+    else:
+        try:
+            start_in, duration_in = gaits
+            start = np.array(start_in, dtype=np.float64, ndmin=1)
+            duration = np.array(duration_in, dtype=np.float64, ndmin=1)
+        except (TypeError, ValueError):
+            raise ValueError(f"{what}: expected a Gait, a list of Gaits or a (start, duration) pair of arrays") from None
+        start = start[None, :] if start.ndim == 1 else start
+        duration = duration[None, :] if duration.ndim == 1 else duration
+    for array in (start, duration):
+        if array.ndim != 2 or array.shape[0] not in (1, n_rows):
+            raise ValueError(f"{what}: expected (L,) or ({n_rows}, L) arrays, got shape {array.shape}")
+    if start.shape[1] != duration.shape[1]:
+        raise ValueError(f"{what}: {start.shape[1]} starts but {duration.shape[1]} durations")
+    _check_disks(start, duration, what)
+    start = np.array(np.broadcast_to(start, (n_rows, start.shape[1])), dtype=np.float64)
+    duration = np.array(np.broadcast_to(duration, (n_rows, duration.shape[1])), dtype=np.float64)
+    return start, duration, names
+
+
+def _per_character(value: Any, n: int, what: str, *, positive: bool = False) -> np.ndarray:
+    array = np.asarray(value, dtype=np.float64)
+    if array.ndim > 1 or (array.ndim == 1 and array.shape[0] != n):
+        raise ValueError(f"{what}: expected a number or an array of shape ({n},), got shape {array.shape}")
+    array = np.ascontiguousarray(np.broadcast_to(array, (n,)), dtype=np.float64).copy()
+    if not np.all(np.isfinite(array)) or np.any(array <= 0.0 if positive else array < 0.0):
+        raise ValueError(f"{what}: expected finite numbers {'> 0' if positive else '>= 0'}")
+    return array
+
+
+def _indices(state: GaitManagerState, character_indices: Any) -> np.ndarray:
+    if isinstance(character_indices, slice):
+        return np.arange(state.n_characters)[character_indices]
+    indices = np.asarray(character_indices)
+    if indices.dtype == np.bool_:
+        if indices.shape != (state.n_characters,):
+            raise ValueError(f"character_indices: a mask must have shape ({state.n_characters},)")
+        return np.flatnonzero(indices)
+    indices = indices.reshape(-1)
+    if indices.size and (not np.issubdtype(indices.dtype, np.integer)
+                         or indices.min() < -state.n_characters or indices.max() >= state.n_characters):
+        raise ValueError(f"character_indices: expected integers in [0, {state.n_characters})")
+    return indices.astype(np.int64) % state.n_characters
+
+
+# --------------------------------------------------------------------------- public API
+
+
+def init_gaits(gaits: Any, n_characters: int, rng_phase_offsets: Any = None, *,
+               transition_rate: Any = DEFAULT_TRANSITION_RATE, duty_factor: Any = None) -> GaitManagerState:
+    """The gait manager state of ``n_characters`` characters, not transitioning.
+
+    gaits:
+        A ``scenarios.Gait`` (every character), a list of ``n_characters``
+        gaits with the same legs, or a ``(start, duration)`` pair of (L,) or
+        (C, L) arrays.
+    rng_phase_offsets:
+        The needles' initial phases: ``None`` (all 0), an integer seed or a
+        ``numpy.random.Generator`` (uniform in [0, 1) per character, so a crowd
+        does not step in unison), or an array (C,) of phases in [0, 1).
+    transition_rate:
+        Cycles of phase per second (number or (C,)), >= 0.
+    duty_factor:
+        ``None``: the disks are the gaits as authored; else a duty factor in
+        (0, 1) (number or (C,)) the durations are scaled to right away
+        (:func:`planner._timing.scaled_swing_durations`).
+
+    A foot swings when the needle *enters* its sector: a foot whose sector
+    already holds a character's initial needle waits for the next cycle,
+    except a sector starting exactly at the needle, which the first
+    :func:`advance` enters.
+    """
+    if isinstance(n_characters, bool) or not isinstance(n_characters, (int, np.integer)) or n_characters < 1:
+        raise ValueError(f"n_characters: expected an integer >= 1, got {n_characters!r}")
+    n = int(n_characters)
+    start, duration, names = _gait_rows(gaits, n, "gaits")
+    if rng_phase_offsets is None:
+        needle = np.zeros(n)
+    elif isinstance(rng_phase_offsets, np.random.Generator):
+        needle = rng_phase_offsets.random(n)
+    elif isinstance(rng_phase_offsets, (int, np.integer)) and not isinstance(rng_phase_offsets, bool):
+        needle = np.random.default_rng(int(rng_phase_offsets)).random(n)
+    else:
+        needle = _per_character(rng_phase_offsets, n, "rng_phase_offsets")
+        if np.any(needle >= 1.0):
+            raise ValueError("rng_phase_offsets: phases must be in [0, 1)")
+    rate = _per_character(transition_rate, n, "transition_rate")
+    duty = np.full(n, np.nan)
+    dest_duration = duration.copy()
+    if duty_factor is not None:
+        duty = _per_character(duty_factor, n, "duty_factor", positive=True)
+        if np.any(duty >= 1.0):
+            raise ValueError("duty_factor: expected duty factors in (0, 1)")
+        dest_duration = scaled_swing_durations(duration, duty)
+    return GaitManagerState(
+        needle=np.ascontiguousarray(needle, dtype=np.float64),
+        disk_start=start.copy(), disk_duration=dest_duration.copy(),
+        dest_start=start.copy(), dest_duration=dest_duration,
+        transition_rate=rate, gait_start=start, gait_duration=duration, duty_factor=duty, leg_names=names)
+
+
+def set_destination(state: GaitManagerState, character_indices: Any, gait: Any, *,
+                    transition_rate: Any = None) -> None:
+    """Start a transition of the given characters (indices, a boolean mask or a slice) toward ``gait``.
+
+    ``gait`` is a ``scenarios.Gait``, a list of gaits (one per selected
+    character) or a ``(start, duration)`` pair of (L,) or (k, L) arrays. The
+    destination durations are scaled to each character's current duty factor
+    (the last :func:`set_speed`). The disks in use move toward it in later
+    :func:`advance` calls, only while their foot is in stance.
+    """
+    rows = _indices(state, character_indices)
+    if rows.size == 0:
+        return
+    start, duration, names = _gait_rows(gait, rows.size, "gait")
+    if start.shape[1] != state.n_legs:
+        raise ValueError(f"gait: has {start.shape[1]} legs, the characters have {state.n_legs}")
+    if names is not None and state.leg_names is not None and names != state.leg_names:
+        raise ValueError(f"gait: legs {names} differ from the characters' legs {state.leg_names}")
+    if transition_rate is not None:
+        rate = _per_character(transition_rate, rows.size, "transition_rate")
+    state.gait_start[rows] = start
+    state.gait_duration[rows] = duration
+    state.dest_start[rows] = start
+    duty = state.duty_factor[rows]
+    scaled = ~np.isnan(duty)
+    dest = duration.copy()
+    if np.any(scaled):
+        dest[scaled] = scaled_swing_durations(duration[scaled], duty[scaled])
+    state.dest_duration[rows] = dest
+    if transition_rate is not None:
+        state.transition_rate[rows] = rate
+
+
+def set_speed(state: GaitManagerState, timing: GaitTiming, speed: Any, height: Any) -> np.ndarray:
+    """Stride frequencies (C,) at ``speed`` (m/s, number or (C,)) for hip height ``height`` (m, number or
+    (C,)); records the duty factors and rescales every destination disk's duration to them
+    (:mod:`planner._timing`). The disks in use follow at the transition rate while in stance."""
+    n = state.n_characters
+    v = _per_character(speed, n, "speed")
+    h = _per_character(height, n, "height", positive=True)
+    frequency = np.empty(n)
+    retime_gaits(timing.to_array(), v, h, state.gait_duration, frequency, state.duty_factor, state.dest_duration)
+    state.dest_start[...] = state.gait_start
+    return frequency
+
+
+def advance(state: GaitManagerState, frequency: Any, dt: float, in_stance: Any,
+            out: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Step every character's needle by ``frequency * dt`` and its stance feet's disks toward the destination.
+
+    frequency:
+        Hz, number or (C,), >= 0 (e.g. from :func:`set_speed`).
+    dt:
+        Seconds, >= 0.
+    in_stance:
+        (C, L) bool, the feet on the ground at the start of the step.
+    out:
+        Optional ``(enter_swing, swing_fraction)`` arrays to write into.
+
+    Returns ``(enter_swing, swing_fraction)``, both (C, L): the stance feet
+    whose sector the needle entered in this step (they must start a swing),
+    and each foot's progress through its sector (0 outside its sector).
+    """
+    n, legs = state.disk_start.shape
+    f = _per_character(frequency, n, "frequency")
+    dt = float(dt)
+    if not np.isfinite(dt) or dt < 0.0:
+        raise ValueError(f"dt: expected a finite number >= 0, got {dt!r}")
+    stance = np.asarray(in_stance)
+    if stance.shape != (n, legs):
+        raise ValueError(f"in_stance: expected shape ({n}, {legs}), got {stance.shape}")
+    stance = np.ascontiguousarray(stance, dtype=np.bool_)
+    if out is None:
+        enter = np.zeros((n, legs), dtype=np.bool_)
+        fraction = np.zeros((n, legs))
+    else:
+        enter, fraction = out
+        if enter.shape != (n, legs) or enter.dtype != np.bool_ or fraction.shape != (n, legs) \
+                or fraction.dtype != np.float64:
+            raise ValueError(f"out: expected a bool and a float64 array of shape ({n}, {legs})")
+    advance_gaits(state.needle, f, dt, state.disk_start, state.disk_duration, state.dest_start, state.dest_duration,
+                  state.transition_rate, stance, enter, fraction)
+    return enter, fraction

@@ -1,0 +1,98 @@
+"""numba kernel: pelvis height, pitch and roll from convex hulls (paper §3.2, Fig. 4b).
+
+For each character, two vertical slices through the pelvis: along its forward
+axis and along its lateral axis. In each slice the points are the ground under
+the body (at the body box's ends and centre) and the feet (stance feet where they
+stand, swinging feet where they will land), as (offset along the axis, height).
+The upper convex hull of those points is the support line; the pelvis sits
+``standing_height`` above the forward hull at the body centre (plus a bobbing
+from the feet phases); pitch and roll are the slopes of the hull segments under
+the centre.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+
+@nb.njit(cache=True)
+def upper_hull_at_zero(s, y, n):
+    """Height and slope at s = 0 of the upper convex hull of points (s[i], y[i]), i < n."""
+    order = np.argsort(s[:n])
+    hs = np.empty(n, dtype=np.float64)
+    hy = np.empty(n, dtype=np.float64)
+    m = 0
+    for k in range(n):
+        i = order[k]
+        while m >= 2:
+            # keep a right turn (upper hull, left to right)
+            cross = (hs[m - 1] - hs[m - 2]) * (y[i] - hy[m - 2]) - (hy[m - 1] - hy[m - 2]) * (s[i] - hs[m - 2])
+            if cross >= 0.0:
+                m -= 1
+            else:
+                break
+        hs[m] = s[i]
+        hy[m] = y[i]
+        m += 1
+    if m == 1 or 0.0 <= hs[0]:
+        return hy[0], 0.0 if m == 1 else (hy[1] - hy[0]) / max(hs[1] - hs[0], 1e-12)
+    for k in range(m - 1):
+        if hs[k] <= 0.0 <= hs[k + 1]:
+            ds = hs[k + 1] - hs[k]
+            if ds <= 1e-12:
+                return max(hy[k], hy[k + 1]), 0.0
+            slope = (hy[k + 1] - hy[k]) / ds
+            return hy[k] + slope * (0.0 - hs[k]), slope
+    slope = (hy[m - 1] - hy[m - 2]) / max(hs[m - 1] - hs[m - 2], 1e-12)
+    return hy[m - 1], slope
+
+
+@nb.njit(cache=True)
+def _sample(top, origin_x, origin_z, cell, x, z):
+    n_rows, n_cols = top.shape
+    r = min(n_rows - 1, max(0, int(math.floor((z - origin_z) / cell))))
+    c = min(n_cols - 1, max(0, int(math.floor((x - origin_x) / cell))))
+    return top[r, c]
+
+
+@nb.njit(cache=True, parallel=True)
+def pelvis_from_hulls(top, origin_x, origin_z, cell, pelvis, heading, support, body_length, body_width,
+                      standing_height, bob, out_y, out_pitch, out_roll, out_hull):
+    """Write pelvis height, pitch, roll and the forward hull height at the centre.
+
+    ``support`` (C, L, 3): the feet used for the hull; ``bob`` (C,) the bobbing offset.
+    """
+    n_chars = pelvis.shape[0]
+    n_legs = support.shape[1]
+    for c in nb.prange(n_chars):
+        cs = math.cos(heading[c])
+        sn = math.sin(heading[c])
+        px = pelvis[c, 0]
+        pz = pelvis[c, 2]
+        s = np.empty(n_legs + 3, dtype=np.float64)
+        y = np.empty(n_legs + 3, dtype=np.float64)
+        t = np.empty(n_legs + 3, dtype=np.float64)
+        yl = np.empty(n_legs + 3, dtype=np.float64)
+        for k in range(3):
+            a = (k - 1) * 0.5 * body_length
+            s[k] = a
+            y[k] = _sample(top, origin_x, origin_z, cell, px + a * cs, pz + a * sn)
+            b = (k - 1) * 0.5 * body_width
+            t[k] = b
+            yl[k] = _sample(top, origin_x, origin_z, cell, px - b * sn, pz + b * cs)
+        for i in range(n_legs):
+            dx = support[c, i, 0] - px
+            dz = support[c, i, 2] - pz
+            s[3 + i] = dx * cs + dz * sn
+            y[3 + i] = support[c, i, 1]
+            t[3 + i] = -dx * sn + dz * cs
+            yl[3 + i] = support[c, i, 1]
+        h, slope = upper_hull_at_zero(s, y, n_legs + 3)
+        hl, slope_l = upper_hull_at_zero(t, yl, n_legs + 3)
+        out_hull[c] = h
+        out_y[c] = h + standing_height + bob[c]
+        out_pitch[c] = math.atan(slope)
+        out_roll[c] = math.atan(slope_l)

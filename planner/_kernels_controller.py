@@ -1,0 +1,138 @@
+"""numba kernels of the character controller's per-frame feet work (paper §3.2)."""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from planner._kernels_geometry import rects_overlap, segments_cross
+
+
+@nb.njit(cache=True)
+def foot_box_conflict(x, y, z, foot_hx, foot_hz, foot_yaw, margin, box_centres, box_sizes, box_yaws, box_forbidden,
+                      box_mask):
+    """True when a foot at (x, y, z) (grown by ``margin``) overlaps a masked box below its
+    top (any forbidden box counts at every height)."""
+    for b in range(box_centres.shape[0]):
+        if not box_mask[b]:
+            continue
+        top = box_centres[b, 1] + 0.5 * box_sizes[b, 1]
+        if not box_forbidden[b] and y >= top - 1e-9:
+            continue
+        if rects_overlap(x, z, foot_hx + margin, foot_hz + margin, foot_yaw, box_centres[b, 0], box_centres[b, 2],
+                         0.5 * box_sizes[b, 0], 0.5 * box_sizes[b, 2], box_yaws[b]):
+            return True
+    return False
+
+
+@nb.njit(cache=True, parallel=True)
+def advance_swings(swing_t, swing_T, trajectories, in_stance, feet, dt, out_landed):
+    """Move every swinging foot along its trajectory at constant speed; flag landings."""
+    n_chars, n_legs, k, _ = trajectories.shape
+    for c in nb.prange(n_chars):
+        for i in range(n_legs):
+            out_landed[c, i] = False
+            if in_stance[c, i]:
+                continue
+            swing_t[c, i] += dt
+            u = swing_t[c, i] / swing_T[c, i] if swing_T[c, i] > 0 else 1.0
+            if u >= 1.0:
+                for d in range(3):
+                    feet[c, i, d] = trajectories[c, i, k - 1, d]
+                out_landed[c, i] = True
+                continue
+            s = u * (k - 1)
+            j = min(int(s), k - 2)
+            a = s - j
+            for d in range(3):
+                feet[c, i, d] = trajectories[c, i, j, d] + a * (trajectories[c, i, j + 1, d] - trajectories[c, i, j, d])
+
+
+@nb.njit(cache=True, parallel=True)
+def swings_invalidated(in_stance, swing_t, swing_T, trajectories, foot_hx, foot_hz, foot_yaws, box_centres,
+                       box_sizes, box_yaws, box_forbidden, box_moving, near_radius, out):
+    """Swinging feet whose remaining trajectory now runs into a moving box (paper §3.2:
+    'something changed in the environment thus invalidating its current 3D trajectory')."""
+    n_chars, n_legs, k, _ = trajectories.shape
+    mask = np.zeros(box_centres.shape[0], dtype=np.bool_)
+    for c in nb.prange(n_chars):
+        local = mask.copy()
+        for i in range(n_legs):
+            out[c, i] = False
+            if in_stance[c, i]:
+                continue
+            tx = trajectories[c, i, k - 1, 0]
+            tz = trajectories[c, i, k - 1, 2]
+            any_near = False
+            for b in range(box_centres.shape[0]):
+                local[b] = box_moving[b] and math.hypot(box_centres[b, 0] - tx, box_centres[b, 2] - tz) < near_radius
+                any_near = any_near or local[b]
+            if not any_near:
+                continue
+            u = swing_t[c, i] / swing_T[c, i] if swing_T[c, i] > 0 else 1.0
+            j0 = min(k - 1, int(u * (k - 1)) + 1)
+            for j in range(j0, k):
+                if foot_box_conflict(trajectories[c, i, j, 0], trajectories[c, i, j, 1], trajectories[c, i, j, 2],
+                                     foot_hx, foot_hz, foot_yaws[c, i], 0.0, box_centres, box_sizes, box_yaws,
+                                     box_forbidden, local):
+                    out[c, i] = True
+                    break
+
+
+@nb.njit(cache=True, parallel=True)
+def stance_threatened(in_stance, feet, foot_hx, foot_hz, foot_yaws, margin, box_centres, box_sizes, box_yaws,
+                      box_forbidden, box_moving, out):
+    """Stance feet that a moving box is about to hit (within ``margin``): they step away."""
+    n_chars, n_legs, _ = feet.shape
+    for c in nb.prange(n_chars):
+        for i in range(n_legs):
+            out[c, i] = False
+            if not in_stance[c, i]:
+                continue
+            if foot_box_conflict(feet[c, i, 0], feet[c, i, 1], feet[c, i, 2], foot_hx, foot_hz, foot_yaws[c, i],
+                                 margin, box_centres, box_sizes, box_yaws, box_forbidden, box_moving):
+                out[c, i] = True
+
+
+@nb.njit(cache=True, parallel=True)
+def count_collisions(feet, foot_hx, foot_hz, foot_yaws, box_centres, box_sizes, box_yaws, box_forbidden, out):
+    """Per character, feet overlapping a box below its top (forbidden: at any height)."""
+    n_chars, n_legs, _ = feet.shape
+    everything = np.ones(box_centres.shape[0], dtype=np.bool_)
+    for c in nb.prange(n_chars):
+        n = 0
+        for i in range(n_legs):
+            if foot_box_conflict(feet[c, i, 0], feet[c, i, 1], feet[c, i, 2], foot_hx, foot_hz, foot_yaws[c, i],
+                                 0.0, box_centres, box_sizes, box_yaws, box_forbidden, everything):
+                n += 1
+        out[c] = n
+
+
+@nb.njit(cache=True, parallel=True)
+def count_leg_crossings(hips, feet, out):
+    """Per character, pairs of legs whose ground projections (hip -> foot) cross."""
+    n_chars, n_legs, _ = feet.shape
+    for c in nb.prange(n_chars):
+        n = 0
+        for i in range(n_legs):
+            for j in range(i + 1, n_legs):
+                if segments_cross(hips[c, i, 0], hips[c, i, 2], feet[c, i, 0], feet[c, i, 2], hips[c, j, 0], hips[c, j, 2],
+                          feet[c, j, 0], feet[c, j, 2]):
+                    n += 1
+        out[c] = n
+
+
+@nb.njit(cache=True)
+def count_forbidden_landings(landed, feet, foot_hx, foot_hz, foot_yaws, box_centres, box_sizes, box_yaws,
+                             box_forbidden):
+    """Feet that just landed on (or touching) a forbidden box."""
+    n = 0
+    for c in range(landed.shape[0]):
+        for i in range(landed.shape[1]):
+            if landed[c, i] and foot_box_conflict(feet[c, i, 0], feet[c, i, 1], feet[c, i, 2], foot_hx, foot_hz,
+                                                  foot_yaws[c, i], 0.0, box_centres, box_sizes, box_yaws,
+                                                  box_forbidden, box_forbidden):
+                n += 1
+    return n

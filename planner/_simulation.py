@@ -1,0 +1,160 @@
+"""Running a crowd for many frames: metrics, timings and the recording.
+
+Metrics are measured after each frame and are not part of the frame time:
+* ``collisions``: feet (stance or swing) overlapping a box below its top (a
+  forbidden box at any height), summed over feet and frames;
+* ``forbidden_footprints``: landings touching a forbidden box;
+* ``leg_crossings``: pairs of legs of a character whose ground projections
+  (hip -> foot) cross, summed over frames;
+* ``max_stance_slip_m``: largest frame-to-frame motion of a stance foot as the
+  IK places it (feet the IK solved in both frames);
+* ``ik_residual_p95_m``: 95th percentile of |IK foot - target| over solved legs.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from footfall._atomic import atomic_path
+from planner._crowd import STAGES, CrowdModel, CrowdState, hips_world, step
+from planner._kernels_controller import count_collisions, count_leg_crossings
+from planner._weights import N_TERMS
+
+RECORDING_FORMAT = "footfall-recording"
+RECORDING_VERSION = 1
+
+
+@dataclass(frozen=True)
+class SimulationSummary:
+    frames: int
+    characters: int
+    steps: int
+    collisions: int
+    forbidden_footprints: int
+    leg_crossings: int
+    max_stance_slip_m: float
+    ik_residual_p95_m: float
+    ms_per_frame_median: float
+    ms_per_frame_mean: float
+    stage_ms_median: dict
+    plans: int
+    holds: int
+    replans: int
+    cells_expanded: int
+    couples_evaluated: int
+    finite: bool
+
+    def to_json(self) -> dict:
+        return asdict(self)
+
+
+class Recorder:
+    """Per-frame arrays (float32) and planning events, saved as one .npz."""
+
+    def __init__(self, model: CrowdModel, state: CrowdState, frames: int):
+        c, l = state.in_stance.shape
+        s = state.angles.shape[2]
+        self.frames = frames
+        self.arrays = {
+            "pelvis": np.zeros((frames, c, 3), np.float32),
+            "orientation": np.zeros((frames, c, 3), np.float32),  # heading, pitch, roll
+            "feet": np.zeros((frames, c, l, 3), np.float32),
+            "in_stance": np.zeros((frames, c, l), np.bool_),
+            "swing_phase": np.zeros((frames, c, l), np.float32),
+            "joint_angles": np.zeros((frames, c, l, s), np.float32),
+            "ik_on": np.zeros((frames, c), np.bool_),
+            "stage_seconds": np.zeros((frames, len(STAGES)), np.float64),
+        }
+        self.events: list[np.ndarray] = []
+
+    def capture(self, k: int, state: CrowdState, timings: dict) -> None:
+        a = self.arrays
+        a["pelvis"][k] = state.pelvis
+        a["orientation"][k] = np.stack([state.heading, state.pitch, state.roll], axis=1)
+        a["feet"][k] = state.feet
+        a["in_stance"][k] = state.in_stance
+        a["swing_phase"][k] = np.where(state.in_stance, 0.0, state.swing_t / np.maximum(state.swing_T, 1e-9))
+        a["joint_angles"][k] = state.angles
+        a["ik_on"][k] = state.ik_on
+        a["stage_seconds"][k] = [timings[s] for s in STAGES]
+        if state.last_plans is not None:
+            cs, ls, kinds, out = state.last_plans
+            ev = np.column_stack([np.full(cs.size, k), cs, ls, kinds, out.valid, out.target, out.scores, out.terms,
+                                  out.counters, out.slice_level])
+            self.events.append(ev)
+
+    def save(self, path, model: CrowdModel, summary: SimulationSummary, meta: dict) -> None:
+        from footfall import __version__
+
+        width = 5 + 3 + 3 + N_TERMS + 6 + 1
+        events = np.concatenate(self.events) if self.events else np.zeros((0, width))
+        header = {"format": RECORDING_FORMAT, "version": RECORDING_VERSION, "footfall": __version__,
+                  "dt": model.dt, "creature": model.creature.name, "leg_names": list(model.creature.leg_names),
+                  "stages": list(STAGES), "summary": summary.to_json(),
+                  "event_columns": ["frame", "character", "leg", "kind", "valid", "target_x", "target_y", "target_z",
+                                    "couple_score", "footprint_score", "trajectory_score"]
+                  + [f"term_{i}" for i in range(N_TERMS)]
+                  + ["couples_evaluated", "couples_2d", "cells_expanded", "wavefronts", "candidates", "slices",
+                     "slice_level_m"], **meta}
+        with atomic_path(path, suffix=".npz") as tmp:
+            with open(tmp, "wb") as fh:
+                np.savez_compressed(fh, header=np.array(json.dumps(header)), events=events, **self.arrays)
+
+
+def simulate(model: CrowdModel, state: CrowdState, frames: int, recorder: Recorder | None = None,
+             progress=None) -> SimulationSummary:
+    """Run ``frames`` steps; never raises on a foot that cannot step (it holds)."""
+    frame_ms = np.zeros(frames)
+    stage_s = np.zeros((frames, len(STAGES)))
+    collisions = 0
+    crossings = 0
+    slip = 0.0
+    residuals = []
+    prev_fk = state.fk_feet.copy()
+    prev_stance = state.in_stance.copy()
+    prev_ik = state.ik_on.copy()
+    finite = True
+    per_char = np.zeros(state.pelvis.shape[0], np.int64)
+    foot_hx = 0.5 * model.creature.foot_length
+    foot_hz = 0.5 * model.creature.foot_width
+    for k in range(frames):
+        timings = step(model, state)
+        stage_s[k] = [timings[s] for s in STAGES]
+        frame_ms[k] = 1e3 * sum(timings.values())
+        # -- metrics (not timed) --
+        obs = model.raster.obstacles
+        if len(obs.yaws):
+            centres, yaws = obs.poses_at(state.t)
+            count_collisions(state.feet, foot_hx, foot_hz, state.foot_yaws, np.ascontiguousarray(centres),
+                             np.ascontiguousarray(obs.sizes, dtype=np.float64), np.ascontiguousarray(yaws),
+                             np.ascontiguousarray(obs.forbidden, dtype=np.bool_), per_char)
+            collisions += int(per_char.sum())
+        count_leg_crossings(hips_world(model, state), state.feet, per_char)
+        crossings += int(per_char.sum())
+        both = state.in_stance & prev_stance & (state.ik_on & prev_ik)[:, None]
+        if both.any():
+            slip = max(slip, float(np.linalg.norm(state.fk_feet[both] - prev_fk[both], axis=1).max()))
+        if state.ik_on.any():
+            residuals.append(state.residual[state.ik_on].ravel().copy())
+        prev_fk[:] = state.fk_feet
+        prev_stance[:] = state.in_stance
+        prev_ik[:] = state.ik_on
+        finite = finite and bool(np.isfinite(state.pelvis).all() and np.isfinite(state.feet).all()
+                                 and np.isfinite(state.angles).all())
+        if recorder is not None:
+            recorder.capture(k, state, timings)
+        if progress is not None:
+            progress(k + 1)
+    res = np.concatenate(residuals) if residuals else np.zeros(1)
+    c = state.counters
+    return SimulationSummary(
+        frames=frames, characters=int(state.pelvis.shape[0]), steps=int(c["steps"]), collisions=collisions,
+        forbidden_footprints=int(c["forbidden_footprints"]), leg_crossings=crossings, max_stance_slip_m=slip,
+        ik_residual_p95_m=float(np.percentile(res, 95)), ms_per_frame_median=float(np.median(frame_ms)), ms_per_frame_mean=float(np.mean(frame_ms)),
+        stage_ms_median={s: float(1e3 * np.median(stage_s[:, i])) for i, s in enumerate(STAGES)},
+        plans=int(c["plans"]), holds=int(c["holds"]), replans=int(c["replans"]),
+        cells_expanded=int(c["cells_expanded"]), couples_evaluated=int(c["couples_evaluated"]), finite=finite)

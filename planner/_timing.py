@@ -1,0 +1,196 @@
+"""The gait timing model: stride frequency and duty factor as functions of speed.
+
+Notation (``/work/shared/biomechanics.md``): v = speed (m/s), h = hip height,
+i.e. leg length (m), g = :data:`GRAVITY`, Fr = v^2 / (g h) the Froude number.
+
+* **Stride length** (dynamic similarity, Alexander 1976; Alexander & Jayes 1983)::
+
+      lambda(v) = stride_coefficient * h * Fr^stride_exponent        (defaults 2.3, 0.3)
+
+  so lambda grows as v^0.6 and the stride frequency v / lambda as v^0.4.
+* **Stride frequency**: f(v) = max(v / lambda(v), min_frequency_hz) for v > 0,
+  and f(0) = 0. v / lambda tends to 0 with v (as v^(1 - 2 stride_exponent)),
+  so at crawling speeds the feet keep stepping at ``min_frequency_hz`` with
+  strides shorter than lambda (v / f); at v = 0 exactly the needle stops
+  (no division by zero: lambda(0) = 0 is never divided by).
+* **Duty factor** falls linearly with speed (Spagna, Valdivia & Mohan 2011 for
+  spiders; Ting et al. 1994 for insects), in units of sqrt(Fr) = v / sqrt(g h)::
+
+      DF(v) = clip(duty_at_rest - duty_slope * v / sqrt(g h), duty_min, duty_max)
+
+  Defaults: a spider (h = 0.12 m) at 0.3 m/s gets DF = 0.66; DF reaches
+  ``duty_min`` = 0.5 at Fr = 1 (the walk / run boundary) and stays there.
+* **Speed and the gait disks** (:func:`scaled_swing_durations`): a gait keeps
+  its pattern of swing starts and its *relative* swing durations, and its mean
+  swing fraction follows the duty factor::
+
+      duration_i(v) = clip((1 - DF(v)) * duration_i / mean(duration), SWING_MIN, SWING_MAX)
+
+  The support rule of ``scenarios._gaits`` is checked on the gait as
+  authored, not on the scaled disks. With ``duty_min`` >= 0.5 every built-in
+  gait keeps it (tested); a lower ``duty_min`` can make e.g. a trot's
+  diagonal pairs overlap so that every foot swings at once.
+
+The tuning code fits these parameters: :meth:`GaitTiming.to_array` /
+:meth:`GaitTiming.from_array` give a flat float64 vector in
+:data:`TIMING_FIELDS` order, which the numba kernels
+(:mod:`planner._kernels_gait`) read through the ``T_*`` index constants.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+GRAVITY = 9.81
+"""g, m/s^2."""
+SWING_MIN = 0.05
+"""Least swing fraction of a speed-scaled disk."""
+SWING_MAX = 0.95
+"""Largest swing fraction of a speed-scaled disk."""
+
+
+def _p(doc: str, default: float, *, unit: str = "-"):
+    return field(default=default, metadata={"doc": doc, "unit": unit})
+
+
+@dataclass(frozen=True)
+class GaitTiming:
+    """Stride length, stride frequency and duty factor as functions of speed (module doc)."""
+
+    stride_coefficient: float = _p("lambda / h at Fr = 1: lambda = stride_coefficient * h * Fr^stride_exponent (> 0)", 2.3)
+    stride_exponent: float = _p("exponent of the Froude number in the stride length, in [0, 0.5) so that f rises with v", 0.3)
+    min_frequency_hz: float = _p("least stride frequency for v > 0 (at v = 0 the needle stops), > 0", 0.5, unit="Hz")
+    duty_at_rest: float = _p("duty factor extrapolated to v = 0, in (0, 1)", 0.72)
+    duty_slope: float = _p("fall of the duty factor per unit of v / sqrt(g h), >= 0", 0.22)
+    duty_min: float = _p("least duty factor (fast speeds), in (0, duty_max]", 0.5)
+    duty_max: float = _p("largest duty factor (slow speeds), in [duty_min, 1)", 0.85)
+
+    def __post_init__(self) -> None:
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+                raise ValueError(f"GaitTiming.{f.name}: expected a number, got {type(value).__name__}")
+            value = float(value)
+            object.__setattr__(self, f.name, value)
+            if not math.isfinite(value):
+                raise ValueError(f"GaitTiming.{f.name}: must be finite, got {value!r}")
+        if self.stride_coefficient <= 0.0:
+            raise ValueError(f"GaitTiming.stride_coefficient: must be > 0, got {self.stride_coefficient!r}")
+        if not 0.0 <= self.stride_exponent < 0.5:
+            raise ValueError(f"GaitTiming.stride_exponent: must be in [0, 0.5), got {self.stride_exponent!r}")
+        if self.min_frequency_hz <= 0.0:
+            raise ValueError(f"GaitTiming.min_frequency_hz: must be > 0, got {self.min_frequency_hz!r}")
+        if not 0.0 < self.duty_at_rest < 1.0:
+            raise ValueError(f"GaitTiming.duty_at_rest: must be in (0, 1), got {self.duty_at_rest!r}")
+        if self.duty_slope < 0.0:
+            raise ValueError(f"GaitTiming.duty_slope: must be >= 0, got {self.duty_slope!r}")
+        if not 0.0 < self.duty_min < 1.0:
+            raise ValueError(f"GaitTiming.duty_min: must be in (0, 1), got {self.duty_min!r}")
+        if not self.duty_min <= self.duty_max < 1.0:
+            raise ValueError(f"GaitTiming.duty_max: must be in [duty_min, 1), got {self.duty_max!r}")
+
+    # -- array round trip ------------------------------------------------------------------
+    def to_array(self) -> np.ndarray:
+        """float64 array in :data:`TIMING_FIELDS` order (lossless)."""
+        return np.array([getattr(self, n) for n in TIMING_FIELDS], dtype=np.float64)
+
+    @classmethod
+    def from_array(cls, values) -> "GaitTiming":
+        values = np.asarray(values, dtype=np.float64)
+        if values.shape != (len(TIMING_FIELDS),):
+            raise ValueError(f"GaitTiming.from_array: expected shape ({len(TIMING_FIELDS)},), got {values.shape}")
+        return cls(**{n: float(v) for n, v in zip(TIMING_FIELDS, values)})
+
+    def to_dict(self) -> dict[str, float]:
+        return {n: getattr(self, n) for n in TIMING_FIELDS}
+
+    @classmethod
+    def describe(cls) -> list[tuple[str, str, str]]:
+        """(name, unit, meaning) of every field, in array order."""
+        return [(f.name, f.metadata["unit"], f.metadata["doc"]) for f in dataclasses.fields(cls)]
+
+
+TIMING_FIELDS: tuple[str, ...] = tuple(f.name for f in dataclasses.fields(GaitTiming))
+# Index constants into GaitTiming.to_array(), used by planner._kernels_gait.
+(T_STRIDE_COEFFICIENT, T_STRIDE_EXPONENT, T_MIN_FREQUENCY, T_DUTY_AT_REST, T_DUTY_SLOPE, T_DUTY_MIN,
+ T_DUTY_MAX) = range(len(TIMING_FIELDS))
+assert TIMING_FIELDS[T_DUTY_MAX] == "duty_max" and TIMING_FIELDS[T_MIN_FREQUENCY] == "min_frequency_hz"
+
+
+# --------------------------------------------------------------------------- vectorised model
+
+
+def _speed_height(v, h) -> tuple[np.ndarray, np.ndarray, bool]:
+    speed = np.asarray(v, dtype=np.float64)
+    height = np.asarray(h, dtype=np.float64)
+    if not np.all(np.isfinite(speed)) or np.any(speed < 0.0):
+        raise ValueError("speed: expected finite numbers >= 0 (m/s)")
+    if not np.all(np.isfinite(height)) or np.any(height <= 0.0):
+        raise ValueError("height: expected finite numbers > 0 (m)")
+    speed, height = np.broadcast_arrays(speed, height)
+    return speed, height, speed.ndim == 0
+
+
+def _out(values: np.ndarray, scalar: bool):
+    return float(values) if scalar else values
+
+
+def froude_number(v, h):
+    """Fr = v^2 / (g h)."""
+    speed, height, scalar = _speed_height(v, h)
+    return _out(speed * speed / (GRAVITY * height), scalar)
+
+
+def stride_length(timing: GaitTiming, v, h):
+    """lambda = stride_coefficient * h * Fr^stride_exponent (m); 0 at v = 0. Broadcasts ``v`` and ``h``."""
+    speed, height, scalar = _speed_height(v, h)
+    froude = speed * speed / (GRAVITY * height)
+    with np.errstate(divide="ignore"):
+        length = timing.stride_coefficient * height * np.power(froude, timing.stride_exponent)
+    # Fr^0 = 1 even at Fr = 0; a creature standing still has no stride.
+    return _out(np.where(speed > 0.0, length, 0.0), scalar)
+
+
+def stride_frequency(timing: GaitTiming, v, h):
+    """f = max(v / lambda, min_frequency_hz) for v > 0, 0 at v = 0 (Hz). Broadcasts ``v`` and ``h``."""
+    speed, height, scalar = _speed_height(v, h)
+    length = np.asarray(stride_length(timing, speed, height), dtype=np.float64)
+    moving = speed > 0.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        natural = np.where(moving, speed / np.where(moving, length, 1.0), 0.0)
+    return _out(np.where(moving, np.maximum(natural, timing.min_frequency_hz), 0.0), scalar)
+
+
+def duty_factor(timing: GaitTiming, v, h):
+    """DF = clip(duty_at_rest - duty_slope * v / sqrt(g h), duty_min, duty_max). Broadcasts ``v`` and ``h``."""
+    speed, height, scalar = _speed_height(v, h)
+    raw = timing.duty_at_rest - timing.duty_slope * speed / np.sqrt(GRAVITY * height)
+    return _out(np.clip(raw, timing.duty_min, timing.duty_max), scalar)
+
+
+def scaled_swing_durations(swing_duration, duty) -> np.ndarray:
+    """Swing fractions of a gait at duty factor ``duty``: (1 - duty) * d_i / mean(d), clipped to [0.05, 0.95].
+
+    ``swing_duration`` is (..., L) (the gait as authored), ``duty`` broadcasts
+    against its leading axes. The pattern of starts is not touched.
+    """
+    durations = np.asarray(swing_duration, dtype=np.float64)
+    duty = np.asarray(duty, dtype=np.float64)
+    if durations.ndim < 1 or not np.all(np.isfinite(durations)) or np.any(durations <= 0.0):
+        raise ValueError("swing_duration: expected an array (..., L) of numbers > 0")
+    if not np.all(np.isfinite(duty)) or np.any((duty <= 0.0) | (duty >= 1.0)):
+        raise ValueError("duty: expected duty factors in (0, 1)")
+    total = durations[..., 0].copy()
+    for j in range(1, durations.shape[-1]):  # summed in leg order, as the kernel does (bitwise equal results)
+        total += durations[..., j]
+    mean = (total / durations.shape[-1])[..., None]
+    return np.clip((1.0 - duty)[..., None] * durations / mean, SWING_MIN, SWING_MAX)
+
+
+def hip_height(creature) -> float:
+    """h of a ``scenarios.Creature``: mean hip height above flat ground (m) when standing."""
+    return float(creature.standing_height + np.mean(np.asarray(creature.hips)[:, 1]))
