@@ -15,14 +15,13 @@ from __future__ import annotations
 
 import time
 
-import numba as nb
 import numpy as np
 
 from planner import DEFAULT_BUDGET, EXHAUSTIVE, FIRST_VALID, PlannerConfig, ScoringWeights, make_batch
 from planner._kernels_batch import plan_feet_serial
 from planner._kernels_foot import footprint_candidates, prepare_foot, slice_maps
 from planner._kernels_geometry import foot_offsets
-from planner._kernels_wavefront import wavefront
+from planner._kernels_wavefront import per_target_wavefronts, wavefront
 from planner._params import C_MARGIN
 from planner._search import MODES
 from scenarios import load_creature, load_scenario
@@ -31,16 +30,6 @@ from benchmarks._situations import scenario_situations
 
 BUDGETS = {"first_valid": FIRST_VALID, "default": DEFAULT_BUDGET, "exhaustive": EXHAUSTIVE}
 SCENARIOS = ("crates", "mixed")
-
-
-@nb.njit(cache=True)
-def _per_target_wavefronts(passable, factor, wp, source, cell, cands, dist, parent):
-    one = np.empty(1, dtype=np.int64)
-    expanded = 0
-    for k in range(cands.size):
-        one[0] = cands[k]
-        expanded += wavefront(passable, factor, wp, source, cell, one, dist, parent)
-    return expanded
 
 
 def _time_best(fn, repeats: int) -> float:
@@ -110,7 +99,7 @@ def _wavefront_speedups(grids, cell, repeats):
         parent = np.empty(passable.size, np.int64)
         t_shared += _time_best(lambda: wavefront(passable, factor, wp, source, cell, cands, dist, parent), repeats)
         t_per_target += _time_best(
-            lambda: _per_target_wavefronts(passable, factor, wp, source, cell, cands, dist, parent), repeats)
+            lambda: per_target_wavefronts(passable, factor, wp, source, cell, cands, dist, parent), repeats)
         costs = np.where(passable.reshape(hp, wp) > 0, factor.reshape(hp, wp), np.inf)
         start = [divmod(source, wp)]
         ends = [divmod(int(c), wp) for c in cands]

@@ -9,7 +9,11 @@ from planner._cache import configure_numba_cache as _configure_numba_cache
 _configure_numba_cache()
 
 from planner._batch import BatchResult, FootBatch, make_batch, plan_batch  # noqa: E402
+from planner._crowd import ControllerConfig, CrowdModel, CrowdState, init_crowd, planner_config_for, step  # noqa: E402
+from planner._gait import GaitManagerState, advance, init_gaits, set_destination, set_speed  # noqa: E402
 from planner._grid import GridFrame  # noqa: E402
+from planner._ik import IKResult, body_rotation, legs_of, rest_pose_angles, solve_legs  # noqa: E402
+from planner._lod import FULL_SEARCH, LOD_MODES, LodConfig  # noqa: E402
 from planner._maps import LocalMaps, WorldRaster  # noqa: E402
 from planner._params import (  # noqa: E402
     DEFAULT_BUDGET,
@@ -18,7 +22,10 @@ from planner._params import (  # noqa: E402
     PlannerConfig,
     SearchBudget,
 )
+from planner._presets import PRESET_SCHEMA_VERSION, Preset, load_preset, preset_dict  # noqa: E402
 from planner._search import COUNTERS, RAW_METRICS, CoupleResult, FootQuery, plan_foot, wavefront_distances  # noqa: E402
+from planner._simulation import RECORDING_VERSION, Recorder, SimulationSummary, simulate  # noqa: E402
+from planner._timing import GaitTiming, duty_factor, stride_frequency, stride_length  # noqa: E402
 from planner._weights import (  # noqa: E402
     FOOTPRINT_TERMS,
     SCORE_TERMS,
@@ -28,27 +35,58 @@ from planner._weights import (  # noqa: E402
 )
 
 __all__ = [
-    "BatchResult",
-    "FootBatch",
-    "make_batch",
-    "plan_batch",
     "COUNTERS",
     "DEFAULT_BUDGET",
     "EXHAUSTIVE",
     "FIRST_VALID",
     "FOOTPRINT_TERMS",
+    "FULL_SEARCH",
+    "LOD_MODES",
+    "PRESET_SCHEMA_VERSION",
     "RAW_METRICS",
+    "RECORDING_VERSION",
     "SCORE_TERMS",
     "TRAJECTORY_TERMS",
     "WEIGHT_FIELDS",
+    "advance",
+    "BatchResult",
+    "body_rotation",
+    "ControllerConfig",
     "CoupleResult",
+    "CrowdModel",
+    "CrowdState",
+    "duty_factor",
+    "FootBatch",
     "FootQuery",
+    "GaitManagerState",
+    "GaitTiming",
     "GridFrame",
+    "IKResult",
+    "init_crowd",
+    "init_gaits",
+    "legs_of",
+    "load_preset",
     "LocalMaps",
+    "LodConfig",
+    "make_batch",
+    "plan_batch",
+    "plan_foot",
+    "planner_config_for",
     "PlannerConfig",
+    "Preset",
+    "preset_dict",
+    "Recorder",
+    "rest_pose_angles",
     "ScoringWeights",
     "SearchBudget",
-    "WorldRaster",
-    "plan_foot",
+    "set_destination",
+    "set_speed",
+    "simulate",
+    "SimulationSummary",
+    "solve_legs",
+    "step",
+    "stride_frequency",
+    "stride_length",
     "wavefront_distances",
+    "WorldRaster",
 ]

@@ -73,7 +73,9 @@ class ControllerConfig:
     step_height_factor: float = 0.3  # x standing height
     reach_margin: float = 0.95  # stance feet beyond this fraction of the reach step
     threat_margin: float = 0.04  # m, a moving box this close to a stance foot makes it step
-    bob_factor: float = 0.2  # x body thickness, pelvis bobbing amplitude
+    bob_factor: float = 0.03  # x standing height, pelvis bobbing amplitude
+    lookahead_frames: int = 3  # stance feet the IK cannot follow this many frames ahead step now
+    ik_slip_margin: float = 3e-4  # m, IK residual that counts as 'cannot follow'
 
 
 def _rot_xz(heading, forward, lateral):
@@ -146,6 +148,9 @@ class CrowdState:
     ik_on: np.ndarray  # (C,) bool, IK solved this frame
     fk_feet: np.ndarray  # (C, L, 3) feet where the IK put them
     hull: np.ndarray  # (C,)
+    pelvis_rise: np.ndarray  # (C,) m, change of pelvis height over the last frame
+    body_held: np.ndarray  # (C,) bool: a stance foot could not follow and could not step: wait a frame
+    last_move: np.ndarray  # (C, 2) m, the pelvis's move on the ground in the last steer stage
     counters: dict = field(default_factory=dict)
     last_plans: object = None  # (chars, legs, kinds, BatchResult) of the last frame, for recordings
 
@@ -209,8 +214,12 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
     state.heading = _wrap(state.heading + np.clip(turn, -ctl.turn_rate * dt, ctl.turn_rate * dt))
     v_des = np.where(arrived, 0.0, state.desired_speed * np.maximum(0.3, np.cos(np.clip(turn, -np.pi / 2, np.pi / 2))))
     state.speed = state.speed + np.clip(v_des - state.speed, -ctl.acceleration * dt, ctl.acceleration * dt)
+    # The body never outruns its legs: a character with a stance foot its leg cannot follow,
+    # and no room to lift it, waits.
+    state.speed[state.body_held] = 0.0
     fwd = np.stack([np.cos(state.heading), np.sin(state.heading)], axis=1)
-    state.pelvis[:, [0, 2]] += fwd * (state.speed * dt)[:, None]
+    state.last_move = fwd * (state.speed * dt)[:, None]
+    state.pelvis[:, [0, 2]] += state.last_move
     # Feet feedback (§3.2): a significant mean offset between preferred and chosen footprints moves the pelvis.
     fb = state.feedback
     significant = np.hypot(fb[:, 0], fb[:, 1]) > ctl.feedback_threshold * model.rest_radius
@@ -251,6 +260,35 @@ def _reach_xz(model: CrowdModel) -> np.ndarray:
     return np.sqrt(np.maximum(reach**2 - dy**2, (0.2 * reach) ** 2))
 
 
+def _stance_unreachable_ahead(model: CrowdModel, state: CrowdState, hips) -> np.ndarray:
+    """(C, L) stance feet whose leg could not reach them ``lookahead_frames`` from now
+    (IK with the hips carried forward; characters without IK are not checked)."""
+    from planner._ik import body_rotation, solve_legs
+
+    out = np.zeros(state.in_stance.shape, dtype=np.bool_)
+    chars = np.flatnonzero(state.ik_on & state.in_stance.any(axis=1))
+    if chars.size == 0:
+        return out
+    ctl = model.controller
+    legs = model.leg_static
+    n, L = chars.size, model.n_legs
+    s = legs.segment_lengths.shape[1]
+    ahead = ctl.lookahead_frames * model.dt * state.speed[chars]
+    shifted = hips[chars].copy()
+    shifted[..., 0] += (ahead * np.cos(state.heading[chars]))[:, None]
+    shifted[..., 2] += (ahead * np.sin(state.heading[chars]))[:, None]
+    # The pelvis keeps rising (or sinking) as it did over the last frame; rising is what
+    # stretches a stance leg, so only a rise is carried forward.
+    shifted[..., 1] += (ctl.lookahead_frames * np.maximum(state.pelvis_rise[chars], 0.0))[:, None]
+    rotation = np.repeat(body_rotation(state.heading[chars], state.pitch[chars], state.roll[chars]), L, axis=0)
+    res = solve_legs(shifted.reshape(n * L, 3), rotation, np.tile(legs.rest_azimuths, n),
+                     np.tile(legs.segment_lengths, (n, 1)), np.tile(legs.limits, (n, 1, 1)),
+                     np.tile(legs.azimuth_limits, n), state.feet[chars].reshape(n * L, 3),
+                     warm_start=state.angles[chars].reshape(n * L, s + 1), max_iterations=8, restarts=0)
+    out[chars] = (res.residual.reshape(n, L) > ctl.ik_slip_margin) & state.in_stance[chars]
+    return out
+
+
 def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips) -> np.ndarray:
     """(C, L) int8 request kinds: 0 none, 1 new swing, 2 forced step, 3 re-plan."""
     ctl = model.controller
@@ -258,6 +296,8 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips) -> 
     kinds = np.zeros(state.in_stance.shape, dtype=np.int8)
     kinds[state.wants_swing & state.in_stance] = 1
     far = np.hypot(state.feet[..., 0] - hips[..., 0], state.feet[..., 2] - hips[..., 2]) > _reach_xz(model)[None, :]
+    cannot_follow = _stance_unreachable_ahead(model, state, hips)
+    far |= cannot_follow
     centres, sizes, yaws, forbidden, moving = boxes
     threatened = np.zeros(state.in_stance.shape, dtype=np.bool_)
     invalid = np.zeros(state.in_stance.shape, dtype=np.bool_)
@@ -268,16 +308,29 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips) -> 
         swings_invalidated(state.in_stance, state.swing_t, state.swing_T, state.trajectories,
                            0.5 * model.creature.foot_length, 0.5 * model.creature.foot_width, state.foot_yaws,
                            centres, sizes, yaws, forbidden, moving, 2.0 * model.rest_radius + 1.0, invalid)
+    # Forced steps (out of reach, or a moving box coming): the worst first, and only while at
+    # least half the feet stay on the ground.
     forced = state.in_stance & (far | threatened) & (kinds == 0)
-    kinds[forced] = 2
+    if forced.any():
+        excess = np.where(forced, np.hypot(state.feet[..., 0] - hips[..., 0], state.feet[..., 2] - hips[..., 2])
+                          + threatened + 10.0 * cannot_follow, -np.inf)
+        rank = np.argsort(np.argsort(-excess, axis=1, kind="stable"), axis=1, kind="stable")
+        room = model.n_legs // 2 - (~state.in_stance).sum(axis=1) - (kinds == 1).sum(axis=1)
+        kinds[forced & (rank < room[:, None])] = 2
+    held = (cannot_follow & (kinds == 0)).any(axis=1)
+    # Held from this frame on: take back this frame's move (the pelvis pose stays too).
+    newly = held & ~state.body_held
+    state.pelvis[newly, 0] -= state.last_move[newly, 0]
+    state.pelvis[newly, 2] -= state.last_move[newly, 1]
+    state.body_held = held
     swinging = ~state.in_stance
     turned = np.abs(_wrap(state.heading[:, None] - state.plan_heading)) > ctl.replan_heading
-    sped = np.abs(state.speed[:, None] - state.plan_speed) > ctl.replan_speed * np.maximum(state.plan_speed, 0.05)
-    kinds[swinging & (turned | sped | invalid)] = 3
-    # A foot never lifts while its neighbours in the gait would leave too few feet on the ground:
-    # forced steps wait while more than half the legs swing.
-    too_many = (~state.in_stance).sum(axis=1) >= max(1, model.n_legs // 2)
-    kinds[(kinds == 2) & too_many[:, None]] = 0
+    scale = np.maximum(state.plan_speed, state.desired_speed[:, None])
+    sped = np.abs(state.speed[:, None] - state.plan_speed) > ctl.replan_speed * scale
+    # A foot about to land lands (re-planning it would only restart its swing), unless its
+    # trajectory is now blocked.
+    landing = state.swing_T - state.swing_t < 3.0 * model.dt
+    kinds[swinging & (((turned | sped) & ~landing) | invalid)] = 3
     return kinds
 
 
@@ -341,9 +394,14 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     support = np.where(state.in_stance[..., None], state.feet, state.swing_target)
     others = np.array([[j for j in range(n_legs) if j != i] for i in range(n_legs)], dtype=np.int64)
     oj = others[ls]  # (F, L-1)
+    # A swinging neighbour is blocked both where its foot is now and where it will land, so two
+    # legs swinging side by side do not cut across each other.
     shift = pred - state.pelvis[cs][:, [0, 2]]
-    legs = np.stack([hips[cs[:, None], oj, 0] + shift[:, None, 0], hips[cs[:, None], oj, 2] + shift[:, None, 1],
-                     support[cs[:, None], oj, 0], support[cs[:, None], oj, 2]], axis=-1).reshape(-1, 4)
+    hx = hips[cs[:, None], oj, 0] + shift[:, None, 0]
+    hz = hips[cs[:, None], oj, 2] + shift[:, None, 1]
+    later = np.stack([hx, hz, support[cs[:, None], oj, 0], support[cs[:, None], oj, 2]], axis=-1)
+    now = np.stack([hx, hz, state.feet[cs[:, None], oj, 0], state.feet[cs[:, None], oj, 2]], axis=-1)
+    legs = np.concatenate([later, now], axis=1).reshape(-1, 4)
     couples, slices, _ = budgets
     elev, ground, forb, origin = maps
     batch = FootBatch(
@@ -353,7 +411,7 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
         sources=np.ascontiguousarray(state.feet[cs, ls]), preferred=np.ascontiguousarray(preferred),
         hips=np.ascontiguousarray(hip_pred), reach_xz=_reach_xz(model)[ls],
         step_height=np.full(f, model.controller.step_height_factor * model.creature.standing_height),
-        legs=np.ascontiguousarray(legs), legs_start=np.arange(f + 1, dtype=np.int64) * (n_legs - 1),
+        legs=np.ascontiguousarray(legs), legs_start=np.arange(f + 1, dtype=np.int64) * 2 * (n_legs - 1),
         block_radius=np.full(f, math.hypot(model.creature.foot_length, model.creature.foot_width)),
         couples_after_first=couples[cs], slice_size=slices[cs], early=np.ones(f, np.bool_))
     out = plan_batch(batch, model.weights, model.config, parallel=True)
@@ -383,12 +441,20 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
 def stage_pelvis(model: CrowdModel, state: CrowdState) -> None:
     r = model.raster
     support = np.ascontiguousarray(np.where(state.in_stance[..., None], state.feet, state.swing_target))
-    bob = model.controller.bob_factor * model.creature.body_thickness * np.sin(4.0 * np.pi * state.gaits.needle)
+    bob = model.controller.bob_factor * model.creature.standing_height * np.sin(4.0 * np.pi * state.gaits.needle)
+    state.pelvis_rise[:] = -state.pelvis[:, 1]
     y = np.empty(state.pelvis.shape[0])
+    pitch = np.empty_like(y)
+    roll = np.empty_like(y)
     pelvis_from_hulls(r.static_top, r.frame.origin_x, r.frame.origin_z, r.frame.cell_size, state.pelvis,
                       state.heading, support, float(model.creature.body_box[0]), float(model.creature.body_box[1]),
-                      float(model.creature.standing_height), bob, y, state.pitch, state.roll, state.hull)
-    state.pelvis[:, 1] = y
+                      float(model.creature.standing_height), bob, y, pitch, roll, state.hull)
+    # A held body (a stance leg at the end of its reach) keeps its whole pose until the leg steps.
+    moving = ~state.body_held
+    state.pelvis[moving, 1] = y[moving]
+    state.pitch[moving] = pitch[moving]
+    state.roll[moving] = roll[moving]
+    state.pelvis_rise += y
 
 
 def stage_ik(model: CrowdModel, state: CrowdState, on_screen: np.ndarray) -> None:
@@ -450,6 +516,14 @@ def spawn_positions(scenario, creature, n: int, spacing_factor: float = 1.5):
     raise InputError(scenario.source, "crowd.count", f"no room for {n} x {creature.name} clear of the obstacles")
 
 
+def planner_config_for(creature) -> PlannerConfig:
+    """The paper's 70 x 70 maps of 7 cm cells, with finer cells (and a smaller candidate disc)
+    for creatures too small for 7 cm: about four cells from the body centre to a rest foot."""
+    rest = float(creature.rest_radius)
+    cell = min(0.07, max(0.01, round(rest / 4.0 / 0.005) * 0.005))
+    return PlannerConfig(cell_size=cell, search_radius_m=min(0.25, 0.75 * rest))
+
+
 def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, seed: int = 0,
                weights: ScoringWeights | None = None, timing=None, lod_mode: str = "off",
                config: PlannerConfig | None = None, controller: ControllerConfig | None = None,
@@ -462,7 +536,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
 
     if lod_mode not in ("on", "zoomed", "off"):
         raise InputError("argument", "--lod", f"expected on, zoomed or off, got {lod_mode!r}")
-    config = config or PlannerConfig()
+    config = config or planner_config_for(creature)
     controller = controller or ControllerConfig()
     weights = weights or ScoringWeights()
     timing = timing or GaitTiming()
@@ -486,6 +560,8 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         raise InputError(scenario.source, "crowd.speed", f"{speed} m/s needs strides of {stride:.2f} m, beyond "
                          f"what legs of reach {reach:.2f} m can take")
     raster = raster or WorldRaster.build(scenario.terrain, scenario.obstacles, config.cell_size)
+    if abs(raster.frame.cell_size - config.cell_size) > 1e-12:
+        raise ValueError(f"raster: cell size {raster.frame.cell_size} differs from the planner's {config.cell_size}")
     spacing = float(scenario.crowd.feet_spacing)
     model = CrowdModel(
         creature=creature, gait=gait, timing=timing, weights=weights, config=config, controller=controller, lod=lod,
@@ -525,10 +601,12 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         trajectories=np.repeat(feet[:, :, None, :], K, axis=2), swing_target=feet.copy(),
         plan_heading=np.repeat(headings[:, None], L, axis=1), plan_speed=np.zeros((n, L)), foot_yaws=yaws,
         gaits=init_gaits([gait] * n, n, rng.uniform(0.0, 1.0, n)), angles=angles, residual=np.zeros((n, L)),
-        ik_on=np.zeros(n, np.bool_), fk_feet=feet.copy(), hull=np.zeros(n),
+        ik_on=np.zeros(n, np.bool_), fk_feet=feet.copy(), hull=np.zeros(n), pelvis_rise=np.zeros(n), body_held=np.zeros(n, np.bool_), last_move=np.zeros((n, 2)),
         counters={k: 0 for k in ("steps", "plans", "holds", "replans", "forbidden_footprints", "cells_expanded",
                                  "couples_evaluated")})
     stage_pelvis(model, state)
+    state.pelvis_rise[:] = 0.0
+    stage_ik(model, state, np.ones(n, np.bool_))
     return model, state
 
 

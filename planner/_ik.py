@@ -30,6 +30,8 @@ from planner._kernels_ik import (
 
 DEFAULT_AZIMUTH_LIMIT = 1.2
 """Default limit (rad) of the leg-plane azimuth joint: |azimuth| <= 1.2."""
+UPRIGHT_LEG_OFFSET = 0.25
+"""A leg whose rest foot is closer to under its hip than this fraction of its reach gets a free azimuth."""
 DEFAULT_MAX_ITERATIONS = 32
 """Default sweep budget per leg (all descents together)."""
 DEFAULT_TOLERANCE = 1e-4
@@ -277,12 +279,16 @@ def legs_of(creature, azimuth_limit: float = DEFAULT_AZIMUTH_LIMIT) -> CreatureL
     if not (np.isfinite(limit) and limit >= 0.0):
         raise ValueError(f"azimuth_limit: expected a finite number >= 0, got {azimuth_limit!r}")
     directions = np.asarray(creature.foot_directions, dtype=np.float64)
+    # A leg whose rest foot stands (nearly) under its hip has no meaningful rest azimuth: the
+    # foot passes on every side of the hip during a stride, so its azimuth is free.
+    offset = np.hypot(creature.rest_feet[:, 0] - creature.hips[:, 0], creature.rest_feet[:, 1] - creature.hips[:, 2])
+    upright = offset < UPRIGHT_LEG_OFFSET * np.asarray(creature.leg_reach, dtype=np.float64)
     return CreatureLegs(
         hips=np.array(creature.hips, dtype=np.float64),
         rest_azimuths=np.arctan2(directions[:, 1], directions[:, 0]),
         segment_lengths=np.array(creature.segment_lengths, dtype=np.float64),
         limits=np.array(creature.joint_limits, dtype=np.float64),
-        azimuth_limits=np.full(creature.n_legs, limit),
+        azimuth_limits=np.where(upright, np.pi, limit),
     )
 
 
@@ -296,12 +302,14 @@ def rest_pose_angles(creature, azimuth_limit: float = DEFAULT_AZIMUTH_LIMIT) -> 
     """(L, S + 1) angles putting each foot on its rest position, pelvis at standing height.
 
     For warm starts. Solved by CCD in the body frame (identity rotation) from a cold start to
-    1e-9 m; every built-in creature's rest pose is reachable within its limits, and its
+    1e-9 m, with the azimuth held within ``azimuth_limit`` even for legs whose azimuth is free
+    (so the rest pose is the canonical one); every built-in creature's rest pose is reachable within its limits, and its
     azimuths come out 0 (up to round-off).
     """
     legs = legs_of(creature, azimuth_limit)
     n = legs.n_legs
     result = solve_legs(legs.hips, np.broadcast_to(np.eye(3), (n, 3, 3)), legs.rest_azimuths, legs.segment_lengths,
-                        legs.limits, legs.azimuth_limits, rest_feet_body(creature), max_iterations=64,
+                        legs.limits, np.minimum(legs.azimuth_limits, azimuth_limit), rest_feet_body(creature),
+                        max_iterations=64,
                         tolerance=1e-9, parallel=False)
     return result.angles

@@ -53,7 +53,8 @@ def plan_feet_parallel(elevation, ground, forbidden, origins, foot_char, foot_sh
                        early, mode, out_valid, out_target, out_slice, out_level, out_scores, out_terms, out_raw,
                        out_counters, out_traj):
     """Same as :func:`plan_feet_serial`, feet spread over the cores (results identical)."""
-    for i in nb.prange(foot_char.size):
+    for k in nb.prange(foot_char.size):
+        i = np.int64(k)  # prange indices are unsigned: a signed index avoids compiling plan_one_into twice
         plan_one_into(i, elevation, ground, forbidden, origins, foot_char, foot_shape, sources, preferred, hips,
                       reach_xz, step_height, legs, legs_start, block_radius, w, cfg, couples_after_first, slice_size,
                       early, mode, out_valid, out_target, out_slice, out_level, out_scores, out_terms, out_raw,

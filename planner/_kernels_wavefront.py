@@ -156,3 +156,15 @@ def wavefront(passable, cost_factor, wp, source, cell, stop_cells, dist, parent)
                 parent[q] = p
                 size = _heap_push(keys, items, size, nd, q)
     return expanded
+
+
+@nb.njit(cache=True)
+def per_target_wavefronts(passable, factor, wp, source, cell, cands, dist, parent):
+    """One wavefront per candidate, each stopping at its target (the baseline the shared
+    wavefront is benchmarked against). Returns the cells expanded."""
+    one = np.empty(1, dtype=np.int64)
+    expanded = 0
+    for k in range(cands.size):
+        one[0] = cands[k]
+        expanded += wavefront(passable, factor, wp, source, cell, one, dist, parent)
+    return expanded

@@ -10,6 +10,7 @@ from scipy.spatial import cKDTree
 
 from planner._ik import (
     DEFAULT_AZIMUTH_LIMIT,
+    UPRIGHT_LEG_OFFSET,
     DEFAULT_MAX_ITERATIONS,
     DEFAULT_TOLERANCE,
     body_rotation,
@@ -350,7 +351,12 @@ def test_rest_pose_angles_put_every_foot_on_its_rest_spot(name):
     legs = legs_of(creature)
     n, s = creature.n_legs, creature.n_segments
     assert legs.hips.shape == (n, 3) and legs.segment_lengths.shape == (n, s)
-    assert legs.limits.shape == (n, s, 2) and np.all(legs.azimuth_limits == DEFAULT_AZIMUTH_LIMIT)
+    assert legs.limits.shape == (n, s, 2)
+    # Legs standing under their hip (the quadruped's) get a free azimuth, the others the default limit.
+    offset = np.hypot(creature.rest_feet[:, 0] - creature.hips[:, 0], creature.rest_feet[:, 1] - creature.hips[:, 2])
+    upright = offset < UPRIGHT_LEG_OFFSET * creature.leg_reach
+    np.testing.assert_array_equal(legs.azimuth_limits, np.where(upright, np.pi, DEFAULT_AZIMUTH_LIMIT))
+    assert upright.all() == (creature.name == 'quadruped') and upright.any() == (creature.name == 'quadruped')
     directions = np.column_stack([np.cos(legs.rest_azimuths), np.sin(legs.rest_azimuths)])
     np.testing.assert_allclose(directions, creature.foot_directions, atol=1e-12)
 

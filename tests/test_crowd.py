@@ -1,0 +1,138 @@
+"""Crowd simulation properties over >= 200 seeded runs of the built-in scenarios and creatures."""
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from planner import PlannerConfig, WorldRaster
+from planner._crowd import init_crowd, planner_config_for
+from planner._simulation import Recorder, simulate
+from scenarios import builtin_creature_names, builtin_scenario_names, default_gait_name, load_creature, load_gait, load_scenario
+
+FRAMES = 40
+SEEDS_PER_PAIR = 9  # 6 scenarios x 4 creatures x 9 seeds = 216 runs
+SLIP_LIMIT_M = 1e-3
+
+_rasters = {}
+
+
+def _raster(scenario, creature):
+    cell = planner_config_for(creature).cell_size
+    if (scenario.name, cell) not in _rasters:
+        _rasters[scenario.name, cell] = WorldRaster.build(scenario.terrain, scenario.obstacles, cell)
+    return _rasters[scenario.name, cell]
+
+
+@pytest.mark.parametrize("scenario_name", builtin_scenario_names())
+@pytest.mark.parametrize("creature_name", builtin_creature_names())
+def test_seeded_runs_are_clean(scenario_name, creature_name):
+    scenario = load_scenario(scenario_name)
+    creature = load_creature(creature_name)
+    gait = load_gait(default_gait_name(creature_name), creature)
+    for seed in range(SEEDS_PER_PAIR):
+        n = 1 + seed % 3
+        lod = ("off", "on", "zoomed")[seed % 3]
+        model, state = init_crowd(scenario, creature, gait, n_characters=n, seed=seed, lod_mode=lod,
+                                  raster=_raster(scenario, creature))
+        pelvis_gap = []
+
+        def watch(_k, state=state, gaps=pelvis_gap):
+            gaps.append(np.abs(state.pelvis[:, 1] - state.hull - creature.standing_height).max())
+
+        summary = simulate(model, state, FRAMES, progress=watch)
+        where = f"{scenario_name}/{creature_name}/seed {seed}"
+        assert summary.finite, where
+        assert summary.collisions == 0, where
+        assert summary.forbidden_footprints == 0, where
+        assert summary.leg_crossings == 0, where
+        assert summary.max_stance_slip_m <= SLIP_LIMIT_M, (where, summary.max_stance_slip_m)
+        assert summary.steps > 0, where
+        assert max(pelvis_gap) <= creature.body_thickness, where
+
+
+def _record(seed, tmp_path, name):
+    scenario = load_scenario("crates-moving")
+    creature = load_creature("spider")
+    gait = load_gait(default_gait_name("spider"), creature)
+    model, state = init_crowd(scenario, creature, gait, n_characters=3, seed=seed, lod_mode="zoomed",
+                              raster=_raster(scenario, creature))
+    rec = Recorder(model, state, 30)
+    summary = simulate(model, state, 30, rec)
+    rec.save(tmp_path / name, model, summary, {"seed": seed})
+    return np.load(tmp_path / name)
+
+
+def test_same_seed_same_recording(tmp_path):
+    a = _record(4, tmp_path, "a.npz")
+    b = _record(4, tmp_path, "b.npz")
+    for key in ("pelvis", "orientation", "feet", "in_stance", "swing_phase", "joint_angles", "ik_on", "events"):
+        np.testing.assert_array_equal(a[key], b[key], err_msg=key)
+    header = json.loads(str(a["header"]))
+    assert header["format"] == "footfall-recording" and header["version"] == 1
+
+
+def _cli(*args):
+    return subprocess.run([sys.executable, "-m", "footfall.cli", *args], capture_output=True, text=True, timeout=600)
+
+
+def test_simulate_json():
+    proc = _cli("simulate", "flat", "--frames", "20", "--characters", "2", "--json")
+    assert proc.returncode == 0, proc.stderr
+    out = json.loads(proc.stdout)
+    for key in ("frames", "characters", "steps", "collisions", "forbidden_footprints", "leg_crossings",
+                "max_stance_slip_m", "ik_residual_p95_m", "ms_per_frame_median"):
+        assert key in out
+    assert out["frames"] == 20 and out["characters"] == 2
+
+
+def _one_line_exit_2(proc, *needles):
+    assert proc.returncode == 2, (proc.returncode, proc.stderr)
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in proc.stderr, proc.stderr
+    for needle in needles:
+        assert needle in lines[0], (needle, lines[0])
+
+
+def test_impossible_inputs_fail_before_the_simulation(tmp_path):
+    # A creature without legs.
+    legless = tmp_path / "legless.toml"
+    legless.write_text("name = 'blob'\nstanding_height = 0.1\nbody_thickness = 0.05\nbody_box = [0.2, 0.1]\n"
+                       "foot = { length = 0.02, width = 0.02 }\n")
+    _one_line_exit_2(_cli("simulate", "flat", "--creature", str(legless), "--frames", "2"), str(legless))
+    # A gait with every foot swinging at once.
+    gait = tmp_path / "float.toml"
+    rows = "\n".join(f"{leg} = {{ start = 0.0, duration = 0.9 }}" for leg in ("LF", "RF", "LH", "RH"))
+    gait.write_text(f"[swing]\n{rows}\n")
+    _one_line_exit_2(_cli("simulate", "flat", "--creature", "quadruped", "--gait", str(gait), "--frames", "2"),
+                     str(gait))
+    # A speed beyond the legs' reach.
+    fast = tmp_path / "fast.toml"
+    fast.write_text(_scenario_text(terrain='kind = "flat"\nsize = [20.0, 20.0]\ncell_size = 0.05', speed=25.0))
+    _one_line_exit_2(_cli("simulate", str(fast), "--frames", "2"), str(fast), "speed")
+    # NaN terrain.
+    nan_map = tmp_path / "nan.npy"
+    heights = np.zeros((200, 200))
+    heights[3, 4] = np.nan
+    np.save(nan_map, heights)
+    nan_scn = tmp_path / "nan.toml"
+    nan_scn.write_text(_scenario_text(terrain=f'kind = "heightmap"\nfile = "{nan_map.name}"\ncell_size = 0.1\n'
+                                              f'height_scale = 1.0', speed=0.3))
+    _one_line_exit_2(_cli("simulate", str(nan_scn), "--frames", "2"), str(nan_scn))
+
+
+def test_creature_too_large_for_its_map_is_refused():
+    from footfall import InputError
+
+    scenario = load_scenario("flat")
+    creature = load_creature("quadruped")
+    gait = load_gait(default_gait_name("quadruped"), creature)
+    with pytest.raises(InputError, match="too large"):
+        init_crowd(scenario, creature, gait, config=PlannerConfig(map_cells=16))
+
+
+def _scenario_text(terrain: str, speed: float) -> str:
+    return (f"name = 'probe'\n[terrain]\n{terrain}\n[crowd]\ncreature = 'spider'\ncentre = [0.0, 0.0]\n"
+            f"speed = {speed}\ngoal = [3.0, 0.0]\n")
