@@ -76,6 +76,8 @@ class ControllerConfig:
     bob_factor: float = 0.03  # x standing height, pelvis bobbing amplitude
     lookahead_frames: int = 3  # stance feet the IK cannot follow this many frames ahead step now
     ik_slip_margin: float = 3e-4  # m, IK residual that counts as 'cannot follow'
+    ik_iterations: int = 16  # CCD sweeps per stance leg and frame, restarts included (warm started)
+    ik_swing_iterations: int = 8  # CCD sweeps per swinging leg and frame, no restarts
 
 
 def _rot_xz(heading, forward, lateral):
@@ -266,26 +268,23 @@ def _stance_unreachable_ahead(model: CrowdModel, state: CrowdState, hips) -> np.
     from planner._ik import body_rotation, solve_legs
 
     out = np.zeros(state.in_stance.shape, dtype=np.bool_)
-    chars = np.flatnonzero(state.ik_on & state.in_stance.any(axis=1))
-    if chars.size == 0:
-        return out
     ctl = model.controller
     legs = model.leg_static
-    n, L = chars.size, model.n_legs
-    s = legs.segment_lengths.shape[1]
-    ahead = ctl.lookahead_frames * model.dt * state.speed[chars]
-    shifted = hips[chars].copy()
-    shifted[..., 0] += (ahead * np.cos(state.heading[chars]))[:, None]
-    shifted[..., 2] += (ahead * np.sin(state.heading[chars]))[:, None]
+    cs, ls = np.nonzero(state.in_stance & state.ik_on[:, None])
+    if cs.size == 0:
+        return out
+    ahead = ctl.lookahead_frames * model.dt * state.speed[cs]
+    shifted = hips[cs, ls].copy()
+    shifted[:, 0] += ahead * np.cos(state.heading[cs])
+    shifted[:, 2] += ahead * np.sin(state.heading[cs])
     # The pelvis keeps rising (or sinking) as it did over the last frame; rising is what
     # stretches a stance leg, so only a rise is carried forward.
-    shifted[..., 1] += (ctl.lookahead_frames * np.maximum(state.pelvis_rise[chars], 0.0))[:, None]
-    rotation = np.repeat(body_rotation(state.heading[chars], state.pitch[chars], state.roll[chars]), L, axis=0)
-    res = solve_legs(shifted.reshape(n * L, 3), rotation, np.tile(legs.rest_azimuths, n),
-                     np.tile(legs.segment_lengths, (n, 1)), np.tile(legs.limits, (n, 1, 1)),
-                     np.tile(legs.azimuth_limits, n), state.feet[chars].reshape(n * L, 3),
-                     warm_start=state.angles[chars].reshape(n * L, s + 1), max_iterations=8, restarts=0)
-    out[chars] = (res.residual.reshape(n, L) > ctl.ik_slip_margin) & state.in_stance[chars]
+    shifted[:, 1] += ctl.lookahead_frames * np.maximum(state.pelvis_rise[cs], 0.0)
+    rotation = body_rotation(state.heading[cs], state.pitch[cs], state.roll[cs])
+    res = solve_legs(shifted, rotation, legs.rest_azimuths[ls], legs.segment_lengths[ls], legs.limits[ls],
+                     legs.azimuth_limits[ls], state.feet[cs, ls], warm_start=state.angles[cs, ls],
+                     max_iterations=4, restarts=0)
+    out[cs, ls] = res.residual > ctl.ik_slip_margin
     return out
 
 
@@ -458,26 +457,29 @@ def stage_pelvis(model: CrowdModel, state: CrowdState) -> None:
 
 
 def stage_ik(model: CrowdModel, state: CrowdState, on_screen: np.ndarray) -> None:
-    """CCD for every leg of the characters that need it, in one kernel call (warm start:
-    the previous frame's angles)."""
+    """CCD for every leg of the characters that need it, warm-started from the previous
+    frame: stance legs with restarts (a stance foot must be followed exactly), swinging
+    legs without (they only need to be close, and restarts are what costs)."""
     from planner._ik import body_rotation, solve_legs
 
-    chars = np.flatnonzero(on_screen)
     state.ik_on[:] = False
-    if chars.size == 0:
+    if not on_screen.any():
         return
     legs = model.leg_static
-    n, L = chars.size, model.n_legs
-    s = legs.segment_lengths.shape[1]
-    rotation = np.repeat(body_rotation(state.heading[chars], state.pitch[chars], state.roll[chars]), L, axis=0)
-    res = solve_legs(hips_world(model, state)[chars].reshape(n * L, 3), rotation, np.tile(legs.rest_azimuths, n),
-                     np.tile(legs.segment_lengths, (n, 1)), np.tile(legs.limits, (n, 1, 1)),
-                     np.tile(legs.azimuth_limits, n), state.feet[chars].reshape(n * L, 3),
-                     warm_start=state.angles[chars].reshape(n * L, s + 1))
-    state.angles[chars] = res.angles.reshape(n, L, s + 1)
-    state.residual[chars] = res.residual.reshape(n, L)
-    state.fk_feet[chars] = res.feet.reshape(n, L, 3)
-    state.ik_on[chars] = True
+    hips = hips_world(model, state)
+    rotation = body_rotation(state.heading, state.pitch, state.roll)
+    ctl = model.controller
+    for stance, restarts, iterations in ((True, 8, ctl.ik_iterations), (False, 0, ctl.ik_swing_iterations)):
+        cs, ls = np.nonzero(on_screen[:, None] & (state.in_stance == stance))
+        if cs.size == 0:
+            continue
+        res = solve_legs(hips[cs, ls], rotation[cs], legs.rest_azimuths[ls], legs.segment_lengths[ls],
+                         legs.limits[ls], legs.azimuth_limits[ls], state.feet[cs, ls], warm_start=state.angles[cs, ls],
+                         max_iterations=iterations, restarts=restarts)
+        state.angles[cs, ls] = res.angles
+        state.residual[cs, ls] = res.residual
+        state.fk_feet[cs, ls] = res.feet
+    state.ik_on[on_screen] = True
 
 
 # ----------------------------------------------------------------------------- set-up

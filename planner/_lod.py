@@ -64,17 +64,24 @@ def look_at(position, target, fov: float) -> CameraPose:
 
 def frame_crowd(points: np.ndarray, fov: float, fraction: float = 1.0, focus: int | None = None,
                 elevation: float = 0.9) -> CameraPose:
-    """A camera above and behind, looking at ``focus`` (or the centroid), pulled back so
-    that ``fraction`` of the characters (the nearest to the look-at point) fit in the cone."""
+    """A camera above and behind, looking at ``focus`` (or the centroid), at the smallest
+    distance (found by bisection) that puts at least ``fraction`` of the points on screen."""
     pts = np.asarray(points, dtype=np.float64)
     target = pts[focus] if focus is not None else pts.mean(axis=0)
-    d = np.sort(np.linalg.norm(pts[:, [0, 2]] - target[[0, 2]], axis=1))
-    k = max(1, int(math.ceil(fraction * len(d))))
-    radius = float(d[k - 1]) + 0.5
-    distance = radius / math.tan(0.45 * fov) + 1.0
     direction = np.array([-math.cos(elevation), math.sin(elevation), -0.3])
     direction /= np.linalg.norm(direction)
-    return look_at(target + distance * direction, target, fov)
+    need = max(1, int(math.ceil(fraction * len(pts))))
+
+    def enough(distance: float) -> bool:
+        return int(visibility(look_at(target + distance * direction, target, fov), pts)[0].sum()) >= need
+
+    lo, hi = 0.5, 1.0
+    while not enough(hi) and hi < 1e4:
+        lo, hi = hi, 2.0 * hi
+    for _ in range(30):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (lo, mid) if enough(mid) else (mid, hi)
+    return look_at(target + hi * direction, target, fov)
 
 
 def visibility(camera: CameraPose, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
