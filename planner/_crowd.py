@@ -315,7 +315,8 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips) -> 
                           + threatened + 10.0 * cannot_follow, -np.inf)
         rank = np.argsort(np.argsort(-excess, axis=1, kind="stable"), axis=1, kind="stable")
         room = model.n_legs // 2 - (~state.in_stance).sum(axis=1) - (kinds == 1).sum(axis=1)
-        kinds[forced & (rank < room[:, None])] = 2
+        # A foot about to be hit by a moving box lifts even past that limit.
+        kinds[forced & ((rank < room[:, None]) | threatened)] = 2
     held = (cannot_follow & (kinds == 0)).any(axis=1)
     # Held from this frame on: take back this frame's move (the pelvis pose stays too).
     newly = held & ~state.body_held

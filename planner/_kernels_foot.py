@@ -271,6 +271,30 @@ def slice_levels(code, boxh_dil, slice_size, eps):
 
 
 @nb.njit(cache=True)
+def _open_escape(passable, blocked, inside, source_p, wp):
+    """A foot standing in a blocked cell (a moving box ran into it) may leave through the
+    blocked region around it: the 4-connected blocked cells reachable from the source are
+    opened, so the wavefront finds the way out (the 3D path rises over them)."""
+    n = passable.size
+    stack = np.empty(n, dtype=np.int64)
+    seen = np.zeros(n, dtype=np.uint8)
+    top = 0
+    stack[top] = source_p
+    top += 1
+    seen[source_p] = 1
+    while top > 0:
+        top -= 1
+        p = stack[top]
+        passable[p] = 1
+        blocked[p] = 0
+        for q in (p - 1, p + 1, p - wp, p + wp):
+            if inside[q] and not seen[q] and blocked[q]:
+                seen[q] = 1
+                stack[top] = q
+                top += 1
+
+
+@nb.njit(cache=True)
 def slice_maps(code, boxh_dil, level, eps, source_p, hp, wp, cell, pot_range, pot_gain, passable, factor, dt):
     """Passable cells, potential-field cost factors and distance to blocked cells for one slice."""
     n = hp * wp
@@ -281,6 +305,8 @@ def slice_maps(code, boxh_dil, level, eps, source_p, hp, wp, cell, pot_range, po
         ok = code[p] == FREE and boxh_dil[p] <= level + eps
         passable[p] = ok or p == source_p
         blocked[p] = inside[p] and not ok
+    if code[source_p] != FREE or boxh_dil[source_p] > level + eps:
+        _open_escape(passable, blocked, inside, source_p, wp)
     chamfer_distance(blocked, inside, hp, wp, cell, dt)
     for p in range(n):
         if pot_range > 0.0 and dt[p] < pot_range:
