@@ -45,6 +45,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from planner._flat import FlatParameters
+
 GRAVITY = 9.81
 """g, m/s^2."""
 SWING_MIN = 0.05
@@ -58,7 +60,7 @@ def _p(doc: str, default: float, *, unit: str = "-"):
 
 
 @dataclass(frozen=True)
-class GaitTiming:
+class GaitTiming(FlatParameters):
     """Stride length, stride frequency and duty factor as functions of speed (module doc)."""
 
     stride_coefficient: float = _p("lambda / h at Fr = 1: lambda = stride_coefficient * h * Fr^stride_exponent (> 0)", 2.3)
@@ -92,26 +94,6 @@ class GaitTiming:
             raise ValueError(f"GaitTiming.duty_min: must be in (0, 1), got {self.duty_min!r}")
         if not self.duty_min <= self.duty_max < 1.0:
             raise ValueError(f"GaitTiming.duty_max: must be in [duty_min, 1), got {self.duty_max!r}")
-
-    # -- array round trip ------------------------------------------------------------------
-    def to_array(self) -> np.ndarray:
-        """float64 array in :data:`TIMING_FIELDS` order (lossless)."""
-        return np.array([getattr(self, n) for n in TIMING_FIELDS], dtype=np.float64)
-
-    @classmethod
-    def from_array(cls, values) -> "GaitTiming":
-        values = np.asarray(values, dtype=np.float64)
-        if values.shape != (len(TIMING_FIELDS),):
-            raise ValueError(f"GaitTiming.from_array: expected shape ({len(TIMING_FIELDS)},), got {values.shape}")
-        return cls(**{n: float(v) for n, v in zip(TIMING_FIELDS, values)})
-
-    def to_dict(self) -> dict[str, float]:
-        return {n: getattr(self, n) for n in TIMING_FIELDS}
-
-    @classmethod
-    def describe(cls) -> list[tuple[str, str, str]]:
-        """(name, unit, meaning) of every field, in array order."""
-        return [(f.name, f.metadata["unit"], f.metadata["doc"]) for f in dataclasses.fields(cls)]
 
 
 TIMING_FIELDS: tuple[str, ...] = tuple(f.name for f in dataclasses.fields(GaitTiming))

@@ -36,13 +36,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from planner._flat import FlatParameters
+
 
 def _w(doc: str, default: float, *, unit: str = "-", scale: bool = False):
     return field(default=default, metadata={"doc": doc, "unit": unit, "scale": scale})
 
 
 @dataclass(frozen=True)
-class ScoringWeights:
+class ScoringWeights(FlatParameters):
     """Weights (dimensionless, >= 0) and reference scales (> 0, units per field)."""
 
     # -- footprint terms (paper §5.1) -------------------------------------------------
@@ -91,26 +93,6 @@ class ScoringWeights:
                 raise ValueError(f"ScoringWeights.{f.name}: a weight must be >= 0, got {value!r}")
         if sum(getattr(self, n) for n in FOOTPRINT_WEIGHT_FIELDS) <= 0:
             raise ValueError("ScoringWeights: at least one footprint weight must be > 0")
-
-    # -- array round trip ------------------------------------------------------------------
-    def to_array(self) -> np.ndarray:
-        """float64 array in :data:`WEIGHT_FIELDS` order (lossless)."""
-        return np.array([getattr(self, n) for n in WEIGHT_FIELDS], dtype=np.float64)
-
-    @classmethod
-    def from_array(cls, values) -> "ScoringWeights":
-        values = np.asarray(values, dtype=np.float64)
-        if values.shape != (len(WEIGHT_FIELDS),):
-            raise ValueError(f"ScoringWeights.from_array: expected shape ({len(WEIGHT_FIELDS)},), got {values.shape}")
-        return cls(**{n: float(v) for n, v in zip(WEIGHT_FIELDS, values)})
-
-    def to_dict(self) -> dict[str, float]:
-        return {n: getattr(self, n) for n in WEIGHT_FIELDS}
-
-    @classmethod
-    def describe(cls) -> list[tuple[str, str, str]]:
-        """(name, unit, meaning) of every field, in array order."""
-        return [(f.name, f.metadata["unit"], f.metadata["doc"]) for f in dataclasses.fields(cls)]
 
 
 WEIGHT_FIELDS: tuple[str, ...] = tuple(f.name for f in dataclasses.fields(ScoringWeights))

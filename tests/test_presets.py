@@ -1,0 +1,51 @@
+"""Weight presets: the runtime loads them, and refuses ones made for something else."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from footfall import InputError
+from planner import GaitTiming, ScoringWeights, load_preset, preset_dict
+
+
+def _write(tmp_path, data, name="p.json"):
+    path = tmp_path / name
+    path.write_text(json.dumps(data))
+    return path
+
+
+def test_round_trip(tmp_path):
+    w = ScoringWeights(footprint_distance=2.5, jerk_ref=1234.5)
+    t = GaitTiming(duty_at_rest=0.7)
+    p = load_preset(_write(tmp_path, preset_dict("spider", w, t, "spider-metachronal-wave")), "spider")
+    assert p.weights == w and p.timing == t and p.gait == "spider-metachronal-wave"
+
+
+@pytest.mark.parametrize(
+    "mutate, field",
+    [
+        (lambda d: d.update(creature="ant"), "creature"),
+        (lambda d: d.update(schema_version=99), "schema_version"),
+        (lambda d: d["weights"].pop("jerk_ref"), "weights.jerk_ref"),
+        (lambda d: d["weights"].update(bogus=1.0), "weights.bogus"),
+        (lambda d: d["weights"].update(slope_critical_rad=-1.0), "weights"),
+        (lambda d: d.update(extra=1), "extra"),
+    ],
+)
+def test_bad_presets_are_refused_naming_the_field(tmp_path, mutate, field):
+    data = preset_dict("spider", ScoringWeights(), GaitTiming())
+    mutate(data)
+    path = _write(tmp_path, data)
+    with pytest.raises(InputError) as e:
+        load_preset(path, "spider")
+    assert str(path) in str(e.value) and field in str(e.value) and "\n" not in str(e.value)
+
+
+def test_cli_refuses_a_preset_for_another_creature(tmp_path):
+    path = _write(tmp_path, preset_dict("ant", ScoringWeights()))
+    proc = subprocess.run([sys.executable, "-m", "footfall.cli", "simulate", "flat", "--frames", "2", "--preset",
+                           str(path)], capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 2 and str(path) in proc.stderr and "creature" in proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1
