@@ -68,6 +68,7 @@ class ControllerConfig:
     avoid_margin: float = 0.35  # m beyond the rest radius where forbidden boxes push the heading
     replan_heading: float = 0.2  # rad
     replan_speed: float = 0.25  # relative
+    replan_spacing: float = 0.1  # relative change of the feet spacing (Fig. 6)
     feedback_threshold: float = 0.15  # x rest radius
     feedback_gain: float = 2.0  # 1/s
     step_height_factor: float = 0.3  # x standing height
@@ -77,7 +78,7 @@ class ControllerConfig:
     lookahead_frames: int = 3  # stance feet the IK cannot follow this many frames ahead step now
     ik_slip_margin: float = 3e-4  # m, IK residual that counts as 'cannot follow'
     ik_iterations: int = 16  # CCD sweeps per stance leg and frame, restarts included (warm started)
-    ik_swing_iterations: int = 8  # CCD sweeps per swinging leg and frame, no restarts
+    ik_swing_iterations: int = 4  # CCD sweeps per swinging leg and frame, no restarts
 
 
 def _rot_xz(heading, forward, lateral):
@@ -143,6 +144,8 @@ class CrowdState:
     swing_target: np.ndarray  # (C, L, 3)
     plan_heading: np.ndarray  # (C, L)
     plan_speed: np.ndarray
+    feet_spacing: np.ndarray  # (C,) scale of the rest feet, user-controlled (paper Fig. 6)
+    plan_spacing: np.ndarray  # (C, L) the scale a swing was planned with
     foot_yaws: np.ndarray  # (C, L)
     gaits: object  # planner._gait.GaitManagerState
     angles: np.ndarray  # (C, L, S + 1)
@@ -330,7 +333,8 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips) -> 
     # A foot about to land lands (re-planning it would only restart its swing), unless its
     # trajectory is now blocked.
     landing = state.swing_T - state.swing_t < 3.0 * model.dt
-    kinds[swinging & (((turned | sped) & ~landing) | invalid)] = 3
+    respaced = np.abs(state.feet_spacing[:, None] - state.plan_spacing) > ctl.replan_spacing * state.plan_spacing
+    kinds[swinging & (((turned | sped | respaced) & ~landing) | invalid)] = 3
     return kinds
 
 
@@ -383,7 +387,8 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     fwd = np.stack([np.cos(heading), np.sin(heading)], axis=1)
     v = state.speed[cs]
     pred = state.pelvis[cs][:, [0, 2]] + fwd * (v * t_swing)[:, None]
-    rx, rz = _rot_xz(heading, model.rest_body[ls, 0], model.rest_body[ls, 1])
+    spacing = state.feet_spacing[cs]
+    rx, rz = _rot_xz(heading, spacing * model.rest_body[ls, 0], spacing * model.rest_body[ls, 1])
     preferred = pred + np.stack([rx, rz], axis=1) + fwd * (0.5 * v * t_stance)[:, None]
     hx, hz = _rot_xz(heading, model.hips_body[ls, 0], model.hips_body[ls, 2])
     hip_pred = pred + np.stack([hx, hz], axis=1)
@@ -425,6 +430,7 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     state.wants_swing[vc, vl] = False
     state.plan_heading[vc, vl] = heading[ok]
     state.plan_speed[vc, vl] = v[ok]
+    state.plan_spacing[vc, vl] = spacing[ok]
     state.foot_yaws[vc, vl] = foot_yaw[ok]
     fresh = ok & new
     if fresh.any():
@@ -519,6 +525,15 @@ def spawn_positions(scenario, creature, n: int, spacing_factor: float = 1.5):
     raise InputError(scenario.source, "crowd.count", f"no room for {n} x {creature.name} clear of the obstacles")
 
 
+def set_feet_spacing(state: CrowdState, characters, scale) -> None:
+    """Change the feet spacing (scale of the rest feet, > 0) of some characters at run time;
+    their swinging feet re-plan (paper §3.2, Fig. 6)."""
+    scale = np.asarray(scale, dtype=np.float64)
+    if not (np.isfinite(scale).all() and (scale > 0).all()):
+        raise ValueError(f"scale: expected positive numbers, got {scale!r}")
+    state.feet_spacing[characters] = scale
+
+
 def planner_config_for(creature) -> PlannerConfig:
     """The paper's 70 x 70 maps of 7 cm cells, with finer cells (and a smaller candidate disc)
     for creatures too small for 7 cm: about four cells from the body centre to a rest foot."""
@@ -602,7 +617,8 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         feedback=np.zeros((n, 2)), feet=feet, in_stance=np.ones((n, L), np.bool_),
         wants_swing=np.zeros((n, L), np.bool_), swing_t=np.zeros((n, L)), swing_T=np.zeros((n, L)),
         trajectories=np.repeat(feet[:, :, None, :], K, axis=2), swing_target=feet.copy(),
-        plan_heading=np.repeat(headings[:, None], L, axis=1), plan_speed=np.zeros((n, L)), foot_yaws=yaws,
+        plan_heading=np.repeat(headings[:, None], L, axis=1), plan_speed=np.zeros((n, L)),
+        feet_spacing=np.ones(n), plan_spacing=np.ones((n, L)), foot_yaws=yaws,
         gaits=init_gaits([gait] * n, n, rng.uniform(0.0, 1.0, n)), angles=angles, residual=np.zeros((n, L)),
         ik_on=np.zeros(n, np.bool_), fk_feet=feet.copy(), hull=np.zeros(n), pelvis_rise=np.zeros(n), body_held=np.zeros(n, np.bool_), last_move=np.zeros((n, 2)),
         counters={k: 0 for k in ("steps", "plans", "holds", "replans", "forbidden_footprints", "cells_expanded",

@@ -136,3 +136,33 @@ def test_creature_too_large_for_its_map_is_refused():
 def _scenario_text(terrain: str, speed: float) -> str:
     return (f"name = 'probe'\n[terrain]\n{terrain}\n[crowd]\ncreature = 'spider'\ncentre = [0.0, 0.0]\n"
             f"speed = {speed}\ngoal = [3.0, 0.0]\n")
+
+
+def test_a_feet_spacing_change_replans_swinging_feet_and_narrows_the_stance():
+    from planner._crowd import set_feet_spacing, step
+
+    scenario = load_scenario("flat")
+    creature = load_creature("spider")
+    gait = load_gait(default_gait_name("spider"), creature)
+    model, state = init_crowd(scenario, creature, gait, n_characters=1, seed=0, raster=_raster(scenario, creature))
+    for _ in range(20):
+        step(model, state)
+
+    def spread():
+        return float(np.mean(np.hypot(state.feet[0, :, 0] - state.pelvis[0, 0], state.feet[0, :, 2] - state.pelvis[0, 2])))
+
+    before = spread()
+    # Change the spacing at a frame where some foot is mid-swing (not about to land).
+    for _ in range(30):
+        mid_swing = ~state.in_stance & (state.swing_T - state.swing_t > 4.05 * model.dt)
+        if mid_swing.any():
+            break
+        step(model, state)
+    assert mid_swing.any()
+    replans = state.counters["replans"]
+    set_feet_spacing(state, [0], 0.8)
+    step(model, state)
+    assert state.counters["replans"] - replans >= int(mid_swing.sum())
+    for _ in range(40):
+        step(model, state)
+    assert spread() < 0.9 * before
