@@ -75,7 +75,8 @@ class ControllerConfig:
     reach_margin: float = 0.95  # stance feet beyond this fraction of the reach step
     threat_margin: float = 0.04  # m, a moving box this close to a stance foot makes it step
     bob_factor: float = 0.03  # x standing height, pelvis bobbing amplitude
-    lookahead_frames: int = 3  # stance feet the IK cannot follow this many frames ahead step now
+    lookahead_frames: int = 4  # stance feet the IK cannot follow this many frames ahead step now
+    lookahead_every: int = 2  # frames between two look-ahead checks of a character (< lookahead_frames)
     ik_slip_margin: float = 3e-4  # m, IK residual that counts as 'cannot follow'
     ik_iterations: int = 16  # CCD sweeps per stance leg and frame, restarts included (warm started)
     ik_swing_iterations: int = 4  # CCD sweeps per swinging leg and frame, no restarts
@@ -156,6 +157,7 @@ class CrowdState:
     pelvis_rise: np.ndarray  # (C,) m, change of pelvis height over the last frame
     body_held: np.ndarray  # (C,) bool: a stance foot could not follow and could not step: wait a frame
     last_move: np.ndarray  # (C, 2) m, the pelvis's move on the ground in the last steer stage
+    cannot_follow: np.ndarray  # (C, L) bool: the last look-ahead found the leg cannot follow its stance foot
     counters: dict = field(default_factory=dict)
     last_plans: object = None  # (chars, legs, kinds, BatchResult) of the last frame, for recordings
 
@@ -270,12 +272,16 @@ def _stance_unreachable_ahead(model: CrowdModel, state: CrowdState, hips) -> np.
     (IK with the hips carried forward; characters without IK are not checked)."""
     from planner._ik import body_rotation, solve_legs
 
-    out = np.zeros(state.in_stance.shape, dtype=np.bool_)
     ctl = model.controller
     legs = model.leg_static
-    cs, ls = np.nonzero(state.in_stance & state.ik_on[:, None])
+    out = state.cannot_follow
+    out &= state.in_stance  # a foot that stepped is followed again
+    # Each character is checked every ``lookahead_every`` frames (in turns, so the cost is
+    # spread); the look-ahead horizon covers the frames in between.
+    turn = (np.arange(state.pelvis.shape[0]) + state.frame) % ctl.lookahead_every == 0
+    cs, ls = np.nonzero(state.in_stance & (state.ik_on & turn)[:, None])
     if cs.size == 0:
-        return out
+        return out.copy()
     ahead = ctl.lookahead_frames * model.dt * state.speed[cs]
     shifted = hips[cs, ls].copy()
     shifted[:, 0] += ahead * np.cos(state.heading[cs])
@@ -288,7 +294,7 @@ def _stance_unreachable_ahead(model: CrowdModel, state: CrowdState, hips) -> np.
                      legs.azimuth_limits[ls], state.feet[cs, ls], warm_start=state.angles[cs, ls],
                      max_iterations=4, restarts=0)
     out[cs, ls] = res.residual > ctl.ik_slip_margin
-    return out
+    return out.copy()
 
 
 def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips) -> np.ndarray:
@@ -620,7 +626,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         plan_heading=np.repeat(headings[:, None], L, axis=1), plan_speed=np.zeros((n, L)),
         feet_spacing=np.ones(n), plan_spacing=np.ones((n, L)), foot_yaws=yaws,
         gaits=init_gaits([gait] * n, n, rng.uniform(0.0, 1.0, n)), angles=angles, residual=np.zeros((n, L)),
-        ik_on=np.zeros(n, np.bool_), fk_feet=feet.copy(), hull=np.zeros(n), pelvis_rise=np.zeros(n), body_held=np.zeros(n, np.bool_), last_move=np.zeros((n, 2)),
+        ik_on=np.zeros(n, np.bool_), fk_feet=feet.copy(), hull=np.zeros(n), pelvis_rise=np.zeros(n), body_held=np.zeros(n, np.bool_), last_move=np.zeros((n, 2)), cannot_follow=np.zeros((n, L), np.bool_),
         counters={k: 0 for k in ("steps", "plans", "holds", "replans", "forbidden_footprints", "cells_expanded",
                                  "couples_evaluated")})
     stage_pelvis(model, state)
