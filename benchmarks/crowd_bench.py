@@ -8,7 +8,6 @@ preparation stage, of the CCD IK stage, and the average FPS (1000 / mean frame m
 
 from __future__ import annotations
 
-import numpy as np
 
 from planner._crowd import init_crowd
 from planner import PlannerConfig, WorldRaster

@@ -22,7 +22,6 @@ from planner._kernels_batch import plan_feet_serial
 from planner._kernels_foot import footprint_candidates, prepare_foot, slice_maps
 from planner._kernels_geometry import foot_offsets
 from planner._kernels_wavefront import per_target_wavefronts, wavefront
-from planner._params import C_MARGIN
 from planner._search import MODES
 from scenarios import load_creature, load_scenario
 

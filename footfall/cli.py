@@ -78,7 +78,7 @@ def plan_cmd(
     """Plan one step of every foot of a creature standing at the scenario's spawn point."""
     import numpy as np
 
-    from planner import PlannerConfig, WorldRaster, plan_foot
+    from planner import WorldRaster, plan_foot, planner_config_for
     from planner._situations import stand, step_queries
     from scenarios import load_creature, load_scenario
 
@@ -87,7 +87,7 @@ def plan_cmd(
     search_budget = _budget(budget)
     if step is not None and not (math.isfinite(step) and step > 0):
         raise InputError("argument", "--step", f"expected a positive number of metres, got {step}")
-    config = PlannerConfig()
+    config = planner_config_for(c)
     raster = WorldRaster.build(s.terrain, s.obstacles, config.cell_size)
     standing = stand(c, raster, float(s.crowd.centre[0]), float(s.crowd.centre[1]), float(s.crowd.heading), 0.0, config)
     step_length = step if step is not None else 0.4 * float(c.max_reach)

@@ -35,14 +35,12 @@ from planner._batch import FootBatch, plan_batch
 from planner._kernels_body import pelvis_from_hulls
 from planner._kernels_controller import (
     advance_swings,
-    count_collisions,
     count_forbidden_landings,
-    count_leg_crossings,
     stance_threatened,
     swings_invalidated,
 )
 from planner._kernels_maps import build_local_maps
-from planner._lod import FULL_SEARCH, LodConfig, frame_crowd, lod_budgets, look_at, visibility
+from planner._lod import FULL_SEARCH, LodConfig, frame_crowd, lod_budgets, visibility
 from planner._maps import WorldRaster
 from planner._params import PlannerConfig
 from planner._weights import ScoringWeights

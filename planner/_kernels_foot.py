@@ -25,16 +25,11 @@ import numpy as np
 
 from planner._grid import cell_centre, cell_of
 from planner._kernels_geometry import segment_point_distance, segments_cross, supercover_visit
-from planner._kernels_wavefront import chamfer_distance, wavefront
-from planner._params import C_CELL, C_MARGIN, C_OBST_MARGIN, C_POT_GAIN, C_POT_RANGE, C_RADIUS, C_SAMPLES, C_SLICE_EPS
+from planner._kernels_wavefront import chamfer_distance
 from planner._weights import (
     N_FOOTPRINT_TERMS,
     N_TERMS,
-    W_CLEARANCE_REF,
-    W_CLIMB_REF,
-    W_CURVATURE_REF,
     W_DISTANCE_SCALE,
-    W_JERK_REF,
     W_LEG_SPACING_REF,
     W_PROXIMITY_REF,
     W_SLOPE_CRITICAL,

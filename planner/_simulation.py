@@ -14,7 +14,6 @@ Metrics are measured after each frame and are not part of the frame time:
 from __future__ import annotations
 
 import json
-import time
 from dataclasses import asdict, dataclass
 
 import numpy as np
