@@ -78,6 +78,7 @@ class ControllerConfig:
     ik_slip_margin: float = 3e-4  # m, IK residual that counts as 'cannot follow'
     ik_iterations: int = 16  # CCD sweeps per stance leg and frame, restarts included (warm started)
     ik_swing_iterations: int = 4  # CCD sweeps per swinging leg and frame, no restarts
+    ik_restarts: int = 2  # restarts of a stalled stance leg (each scans poses: the costly part)
 
 
 def _rot_xz(heading, forward, lateral):
@@ -480,7 +481,7 @@ def stage_ik(model: CrowdModel, state: CrowdState, on_screen: np.ndarray) -> Non
     hips = hips_world(model, state)
     rotation = body_rotation(state.heading, state.pitch, state.roll)
     ctl = model.controller
-    for stance, restarts, iterations in ((True, 8, ctl.ik_iterations), (False, 0, ctl.ik_swing_iterations)):
+    for stance, restarts, iterations in ((True, ctl.ik_restarts, ctl.ik_iterations), (False, 0, ctl.ik_swing_iterations)):
         cs, ls = np.nonzero(on_screen[:, None] & (state.in_stance == stance))
         if cs.size == 0:
             continue
