@@ -228,7 +228,7 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
     state.pelvis[:, [0, 2]] += state.last_move
     # Feet feedback (§3.2): a significant mean offset between preferred and chosen footprints moves the pelvis.
     fb = state.feedback
-    significant = np.hypot(fb[:, 0], fb[:, 1]) > ctl.feedback_threshold * model.rest_radius
+    significant = (np.hypot(fb[:, 0], fb[:, 1]) > ctl.feedback_threshold * model.rest_radius) & ~state.body_held
     if significant.any():
         move = fb[significant] * min(1.0, ctl.feedback_gain * dt)
         idx = np.flatnonzero(significant)
