@@ -28,6 +28,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -116,6 +117,12 @@ class CrowdModel:
         from planner._timing import hip_height
 
         return hip_height(self.creature)
+
+    @cached_property
+    def other_legs(self) -> np.ndarray:
+        """(L, L - 1) for each leg, the indices of the others."""
+        n = self.n_legs
+        return np.array([[j for j in range(n) if j != i] for i in range(n)], dtype=np.int64).reshape(n, n - 1)
 
     @property
     def rest_radius(self) -> float:
@@ -266,13 +273,23 @@ def _reach_xz(model: CrowdModel) -> np.ndarray:
     return np.sqrt(np.maximum(reach**2 - dy**2, (0.2 * reach) ** 2))
 
 
+def _solve_feet(model: CrowdModel, state: CrowdState, cs, ls, hips, rotation, iterations: int, restarts: int):
+    """CCD for legs (cs, ls) reaching for their feet from ``hips``, warm-started from the
+    current angles (the one IK call of the controller's look-ahead and IK stages)."""
+    from planner._ik import solve_legs
+
+    legs = model.leg_static
+    return solve_legs(hips, rotation, legs.rest_azimuths[ls], legs.segment_lengths[ls], legs.limits[ls],
+                      legs.azimuth_limits[ls], state.feet[cs, ls], warm_start=state.angles[cs, ls],
+                      max_iterations=iterations, restarts=restarts)
+
+
 def _stance_unreachable_ahead(model: CrowdModel, state: CrowdState, hips) -> np.ndarray:
     """(C, L) stance feet whose leg could not reach them ``lookahead_frames`` from now
     (IK with the hips carried forward; characters without IK are not checked)."""
-    from planner._ik import body_rotation, solve_legs
+    from planner._ik import body_rotation
 
     ctl = model.controller
-    legs = model.leg_static
     out = state.cannot_follow
     out &= state.in_stance  # a foot that stepped is followed again
     # Each character is checked every ``lookahead_every`` frames (in turns, so the cost is
@@ -289,9 +306,7 @@ def _stance_unreachable_ahead(model: CrowdModel, state: CrowdState, hips) -> np.
     # stretches a stance leg, so only a rise is carried forward.
     shifted[:, 1] += ctl.lookahead_frames * np.maximum(state.pelvis_rise[cs], 0.0)
     rotation = body_rotation(state.heading[cs], state.pitch[cs], state.roll[cs])
-    res = solve_legs(shifted, rotation, legs.rest_azimuths[ls], legs.segment_lengths[ls], legs.limits[ls],
-                     legs.azimuth_limits[ls], state.feet[cs, ls], warm_start=state.angles[cs, ls],
-                     max_iterations=4, restarts=0)
+    res = _solve_feet(model, state, cs, ls, shifted, rotation, iterations=4, restarts=0)
     out[cs, ls] = res.residual > ctl.ik_slip_margin
     return out.copy()
 
@@ -402,8 +417,7 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     # where they stand (or will land). Mixing predicted and current hips would make legs
     # 'cross' at the hips.
     support = np.where(state.in_stance[..., None], state.feet, state.swing_target)
-    others = np.array([[j for j in range(n_legs) if j != i] for i in range(n_legs)], dtype=np.int64)
-    oj = others[ls]  # (F, L-1)
+    oj = model.other_legs[ls]  # (F, L-1)
     # A swinging neighbour is blocked both where its foot is now and where it will land, so two
     # legs swinging side by side do not cut across each other.
     shift = pred - state.pelvis[cs][:, [0, 2]]
@@ -472,12 +486,11 @@ def stage_ik(model: CrowdModel, state: CrowdState, on_screen: np.ndarray) -> Non
     """CCD for every leg of the characters that need it, warm-started from the previous
     frame: stance legs with restarts (a stance foot must be followed exactly), swinging
     legs without (they only need to be close, and restarts are what costs)."""
-    from planner._ik import body_rotation, solve_legs
+    from planner._ik import body_rotation
 
     state.ik_on[:] = False
     if not on_screen.any():
         return
-    legs = model.leg_static
     hips = hips_world(model, state)
     rotation = body_rotation(state.heading, state.pitch, state.roll)
     ctl = model.controller
@@ -485,9 +498,7 @@ def stage_ik(model: CrowdModel, state: CrowdState, on_screen: np.ndarray) -> Non
         cs, ls = np.nonzero(on_screen[:, None] & (state.in_stance == stance))
         if cs.size == 0:
             continue
-        res = solve_legs(hips[cs, ls], rotation[cs], legs.rest_azimuths[ls], legs.segment_lengths[ls],
-                         legs.limits[ls], legs.azimuth_limits[ls], state.feet[cs, ls], warm_start=state.angles[cs, ls],
-                         max_iterations=iterations, restarts=restarts)
+        res = _solve_feet(model, state, cs, ls, hips[cs, ls], rotation[cs], iterations, restarts)
         state.angles[cs, ls] = res.angles
         state.residual[cs, ls] = res.residual
         state.fk_feet[cs, ls] = res.feet
