@@ -81,6 +81,13 @@ rotation axis: a target at the hip, a degenerate leg plane), so no NaN ever
 arises. No step increases the distance, so the residual never grows in a
 descent.
 
+Each descent first takes the azimuth step (a warm-started leg whose target moved
+sideways then solves in the right plane), and a sweep ends at the first step
+that brings the foot within the tolerance: a stance leg following its foot
+while the body moves usually converges within its first sweep. The chain's
+planar points and angles are cached per descent and recomputed from the moved
+hinge on only (:func:`_chain_from`, bit-identical to :func:`_planar_point`).
+
 Start, restarts and stops: a warm start is first brought into the limits
 (:func:`nearest_in_limits`); a cold start takes the grid pose nearest the
 target instead. The grid has ``k ** S`` hinge poses, k evenly spaced angles
@@ -181,10 +188,45 @@ def _planar_point(lengths, q, b, upto):
     return x, y, phi
 
 
+# The chain cache of a descent: row k (0 <= k <= S) holds the proximal end of segment k
+# (row S: the foot) in the leg plane, and, for k < S, the cumulative pitch phi_k of segment
+# k with its cosine and sine. A step that moves hinge j recomputes rows j.. only, in the
+# summation order of :func:`_planar_point`, so cached values are bit-identical to it: the
+# cache only saves the trigonometry of the unchanged proximal segments (most of a sweep's cost).
+CH_X, CH_Y, CH_PHI, CH_COS, CH_SIN = range(5)
+N_CHAIN = 5
+
+
+@nb.njit(cache=True)
+def _chain_from(b, lengths, q, j, chain):
+    """Recompute the chain cache from hinge ``j`` on (rows j + 1 .. S, and the angles of rows j ..)."""
+    n_seg = lengths.shape[1]
+    if j == 0:
+        chain[0, CH_X] = 0.0
+        chain[0, CH_Y] = 0.0
+    phi = chain[j - 1, CH_PHI] if j > 0 else 0.0
+    for k in range(j, n_seg):
+        phi += q[b, k + 1]
+        c = math.cos(phi)
+        s = math.sin(phi)
+        chain[k, CH_PHI] = phi
+        chain[k, CH_COS] = c
+        chain[k, CH_SIN] = s
+        chain[k + 1, CH_X] = chain[k, CH_X] + lengths[b, k] * c
+        chain[k + 1, CH_Y] = chain[k, CH_Y] - lengths[b, k] * s
+
+
+@nb.njit(cache=True)
+def _phi_before(chain, k):
+    """Cumulative pitch before segment ``k`` (0 at the hip)."""
+    return chain[k - 1, CH_PHI] if k > 0 else 0.0
+
+
 @nb.njit(cache=True)
 def _grid_angle(lo, hi, k, levels):
-    """Level ``k`` of ``levels`` evenly spaced angles from lo to hi (both included)."""
-    return lo + k / (levels - 1) * (hi - lo)
+    """Level ``k`` of ``levels`` evenly spaced angles from lo to hi (both included, exactly:
+    ``lo + 1.0 * (hi - lo)`` can round past hi)."""
+    return min(hi, lo + k / (levels - 1) * (hi - lo))
 
 
 @nb.njit(cache=True)
@@ -253,9 +295,10 @@ def _set_grid_pose(b, code, levels, lengths, limits, azimuth_limits, df, dl, alp
 
 
 @nb.njit(cache=True)
-def _hinge_step(b, j, lengths, limits, q, fx, fy, tx, ty):
+def _hinge_step(b, j, lengths, limits, q, fx, fy, tx, ty, chain):
     """Single-joint CCD step of hinge ``j`` (exact minimiser, clamped). Returns (changed, fx, fy)."""
-    px, py, _ = _planar_point(lengths, q, b, j)
+    px = chain[j, CH_X]
+    py = chain[j, CH_Y]
     ax = fx - px
     ay = fy - py
     bx = tx - px
@@ -269,12 +312,13 @@ def _hinge_step(b, j, lengths, limits, q, fx, fy, tx, ty):
     if new == old:
         return False, fx, fy
     q[b, j + 1] = new
-    nx, ny, _ = _planar_point(lengths, q, b, lengths.shape[1])
-    return True, nx, ny
+    _chain_from(b, lengths, q, j, chain)
+    n_seg = lengths.shape[1]
+    return True, chain[n_seg, CH_X], chain[n_seg, CH_Y]
 
 
 @nb.njit(cache=True)
-def _pair_step(b, i, j, lengths, limits, q, fx, fy, tx, ty, mirror):
+def _pair_step(b, i, j, lengths, limits, q, fx, fy, tx, ty, mirror, chain):
     """Two-hinge closed-form step of hinges ``i < j`` (the rest of the leg rigid), kept only if closer.
 
     The rigid link from hinge i to hinge j (length A) and the rigid "virtual
@@ -288,11 +332,13 @@ def _pair_step(b, i, j, lengths, limits, q, fx, fy, tx, ty, mirror):
     pair is bent now is considered (warm starts: no flip of a knee to its mirror
     pose for a small target move). Returns (changed, fx, fy).
     """
-    px, py, phi_before = _planar_point(lengths, q, b, i)
-    jx, jy, phi_j = _planar_point(lengths, q, b, j + 1)
-    # joint j itself sits at the end of segment j - 1
-    jx -= lengths[b, j] * math.cos(phi_j)
-    jy += lengths[b, j] * math.sin(phi_j)
+    px = chain[i, CH_X]
+    py = chain[i, CH_Y]
+    phi_before = _phi_before(chain, i)
+    phi_j = chain[j, CH_PHI]
+    # joint j itself sits at the end of segment j - 1 (from the end of segment j, as ever: same bits)
+    jx = chain[j + 1, CH_X] - lengths[b, j] * chain[j, CH_COS]
+    jy = chain[j + 1, CH_Y] + lengths[b, j] * chain[j, CH_SIN]
     ax = jx - px
     ay = jy - py
     a_len = math.hypot(ax, ay)
@@ -349,13 +395,14 @@ def _pair_step(b, i, j, lengths, limits, q, fx, fy, tx, ty, mirror):
         return False, fx, fy
     q[b, i + 1] = best_i
     q[b, j + 1] = best_j
-    nx, ny, _ = _planar_point(lengths, q, b, lengths.shape[1])
-    return True, nx, ny
+    _chain_from(b, lengths, q, i, chain)
+    n_seg = lengths.shape[1]
+    return True, chain[n_seg, CH_X], chain[n_seg, CH_Y]
 
 
 @nb.njit(cache=True)
 def _descend(b, lengths, limits, azimuth_limits, df, du, dl, alpha, pair_steps, mirror, budget, tolerance,
-             stop_on_stall, q):
+             stop_on_stall, q, chain):
     """CCD sweeps on q[b] from its current pose. Returns (residual, sweeps used, stopped by a stall).
 
     Stops below ``tolerance``, after ``budget`` sweeps, at a fixed point, or (with
@@ -363,28 +410,47 @@ def _descend(b, lengths, limits, azimuth_limits, df, du, dl, alpha, pair_steps, 
     the residual.
     """
     n_seg = lengths.shape[1]
+    _chain_from(b, lengths, q, 0, chain)
+    fx = chain[n_seg, CH_X]
+    fy = chain[n_seg, CH_Y]
+    # The leg plane first: a warm-started leg whose target moved sideways (the body moved)
+    # then solves in the right plane, and can stop within its first sweep.
+    if budget > 0:
+        q[b, 0] = _azimuth_for(fx, q[b, 0], df, dl, alpha, azimuth_limits[b])
     tx, ty, tn = _in_plane_target(df, du, dl, alpha + q[b, 0])
-    fx, fy, _ = _planar_point(lengths, q, b, n_seg)
     residual = math.sqrt((fx - tx) ** 2 + (fy - ty) ** 2 + tn * tn)
     used = 0
     while residual >= tolerance and used < budget:
         used += 1
         changed = False
-        # hinges, last to first: rotate the foot about hinge j towards the target, in the leg plane
+        previous = residual
+        # hinges, last to first: rotate the foot about hinge j towards the target, in the leg plane;
+        # the sweep ends as soon as a step brings the foot within the tolerance
+        reached = False
+        tn2 = tn * tn
         for j in range(n_seg - 1, -1, -1):
-            moved, fx, fy = _hinge_step(b, j, lengths, limits, q, fx, fy, tx, ty)
+            moved, fx, fy = _hinge_step(b, j, lengths, limits, q, fx, fy, tx, ty, chain)
             changed |= moved
+            if moved and (fx - tx) ** 2 + (fy - ty) ** 2 + tn2 < tolerance * tolerance:
+                reached = True
+                break
             if pair_steps:
                 for i in range(j - 1, -1, -1):
-                    moved, fx, fy = _pair_step(b, i, j, lengths, limits, q, fx, fy, tx, ty, mirror)
+                    moved, fx, fy = _pair_step(b, i, j, lengths, limits, q, fx, fy, tx, ty, mirror, chain)
                     changed |= moved
+                    if moved and (fx - tx) ** 2 + (fy - ty) ** 2 + tn2 < tolerance * tolerance:
+                        reached = True
+                        break
+                if reached:
+                    break
+        if reached:
+            return math.sqrt((fx - tx) ** 2 + (fy - ty) ** 2 + tn2), used, False
         # azimuth: analytic
         new = _azimuth_for(fx, q[b, 0], df, dl, alpha, azimuth_limits[b])
         if new != q[b, 0]:
             q[b, 0] = new
             changed = True
             tx, ty, tn = _in_plane_target(df, du, dl, alpha + new)
-        previous = residual
         residual = math.sqrt((fx - tx) ** 2 + (fy - ty) ** 2 + tn * tn)
         if not changed:
             break
@@ -418,6 +484,7 @@ def _solve_one(b, hips, rotations, rest_azimuths, lengths, limits, azimuth_limit
     need_seed = cold
     polish = False  # last round: more sweeps on the best pose, without stall stops
     best = np.empty(n_seg + 1, dtype=np.float64)
+    chain = np.empty((n_seg + 1, N_CHAIN), dtype=np.float64)
     best_residual = np.inf
     have_best = False
     best_seeded = False  # the best pose descends from a grid pose (not from the warm start)
@@ -435,7 +502,7 @@ def _solve_one(b, hips, rotations, rest_azimuths, lengths, limits, azimuth_limit
         seeded = need_seed or (polish and best_seeded)
         residual, sweeps, stalled = _descend(b, lengths, limits, azimuth_limits, df, du, dl, alpha, pair_steps,
                                              seeded, max_iterations - used, tolerance,
-                                             attempt < restarts and not polish, q)
+                                             attempt < restarts and not polish, q, chain)
         used += sweeps
         # a restart must converge or beat the best by more than the tolerance: no jump to another
         # pose for nothing (the polish continues the best pose, it never ends worse)
