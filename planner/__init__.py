@@ -12,6 +12,7 @@ from planner._batch import BatchResult, FootBatch, make_batch, plan_batch  # noq
 from planner._crowd import ControllerConfig, CrowdModel, CrowdState, init_crowd, planner_config_for, step  # noqa: E402
 from planner._gait import GaitManagerState, advance, init_gaits, set_destination, set_speed  # noqa: E402
 from planner._grid import GridFrame  # noqa: E402
+from planner._harvest import FEATURES, FootHarvest, Harvest, harvest_foot, harvest_situations  # noqa: E402
 from planner._ik import IKResult, body_rotation, legs_of, rest_pose_angles, solve_legs  # noqa: E402
 from planner._lod import FULL_SEARCH, LOD_MODES, LodConfig  # noqa: E402
 from planner._maps import LocalMaps, WorldRaster  # noqa: E402
@@ -38,6 +39,7 @@ __all__ = [
     "COUNTERS",
     "DEFAULT_BUDGET",
     "EXHAUSTIVE",
+    "FEATURES",
     "FIRST_VALID",
     "FOOTPRINT_TERMS",
     "FULL_SEARCH",
@@ -57,10 +59,14 @@ __all__ = [
     "CrowdState",
     "duty_factor",
     "FootBatch",
+    "FootHarvest",
     "FootQuery",
     "GaitManagerState",
     "GaitTiming",
     "GridFrame",
+    "harvest_foot",
+    "harvest_situations",
+    "Harvest",
     "IKResult",
     "init_crowd",
     "init_gaits",

@@ -166,6 +166,7 @@ class CrowdState:
     cannot_follow: np.ndarray  # (C, L) bool: the last look-ahead found the leg cannot follow its stance foot
     counters: dict = field(default_factory=dict)
     last_plans: object = None  # (chars, legs, kinds, BatchResult) of the last frame, for recordings
+    last_batch: object = None  # the FootBatch planned in the last frame (what the tuning harvest re-scores)
 
 
 def hips_world(model: CrowdModel, state: CrowdState) -> np.ndarray:
@@ -686,11 +687,13 @@ def step(model: CrowdModel, state: CrowdState) -> dict[str, float]:
     if chars.size:
         maps = stage_maps(model, state, chars, boxes)
         t5 = clock()
-        _, out, cs, ls = stage_plan(model, state, kinds, frequency, budgets, maps, chars, hips)
+        batch, out, cs, ls = stage_plan(model, state, kinds, frequency, budgets, maps, chars, hips)
         state.last_plans = (cs, ls, kinds[cs, ls], out)
+        state.last_batch = batch
     else:
         t5 = clock()
         state.last_plans = None
+        state.last_batch = None
     t6 = clock()
     stage_pelvis(model, state)
     t7 = clock()

@@ -29,7 +29,11 @@ from planner._kernels_wavefront import chamfer_distance
 from planner._weights import (
     N_FOOTPRINT_TERMS,
     N_TERMS,
+    W_CLEARANCE_REF,
+    W_CLIMB_REF,
+    W_CURVATURE_REF,
     W_DISTANCE_SCALE,
+    W_JERK_REF,
     W_LEG_SPACING_REF,
     W_PROXIMITY_REF,
     W_SLOPE_CRITICAL,
@@ -54,6 +58,9 @@ U_HI = 0.95
 # Raw trajectory metrics, in this order, in results.
 RAW_LENGTH, RAW_CURVATURE, RAW_CLEARANCE, RAW_CLIMB, RAW_JERK = range(5)
 N_RAW = 5
+# Raw footprint features, in this order (footprint_features; the harvest's rows; tuning/).
+FEAT_DISTANCE, FEAT_ROUGHNESS, FEAT_SLOPE, FEAT_LEG_GAP, FEAT_PROXIMITY = range(5)
+N_FEATURES = 5
 # Counters, in this order, in results.
 CNT_COUPLES_3D, CNT_COUPLES_2D, CNT_EXPANDED, CNT_WAVEFRONTS, CNT_CANDIDATES, CNT_SLICES = range(6)
 N_COUNTERS = 6
@@ -92,6 +99,24 @@ def prepare_foot(elevation, ground, forbidden, origin_x, origin_z, cell, offsets
             emax = -np.inf
             hmax = 0.0
             touches_forbidden = False
+            for k in range(offsets.shape[0]):
+                    r2 = r + offsets[k, 0]
+                    c2 = c + offsets[k, 1]
+                    e = elevation[r2, c2]
+                    emax = max(emax, e)
+                    hmax = max(hmax, e - ground[r2, c2])
+                    touches_forbidden |= forbidden[r2, c2] != 0
+                elev_raw[p] = elevation[r, c]
+                elev_dil[p] = emax
+                boxh_dil[p] = hmax
+                if 1 <= rr < hp - 1 and 1 <= cc < wp - 1:
+                    if forbidden[r, c]:
+                        code[p] = FORBIDDEN
+                    elif touches_forbidden:
+                        code[p] = SIZE_INCREASE
+                    else:
+                        code[p] = FREE
+                continue
             for k in range(offsets.shape[0]):
                 r2 = r + offsets[k, 0]
                 c2 = c + offsets[k, 1]
@@ -149,19 +174,19 @@ def prepare_foot(elevation, ground, forbidden, origin_x, origin_z, cell, offsets
 
 
 @nb.njit(cache=True)
-def footprint_terms(p, x, z, code, elev_dil, elev_raw, prox_dt, wp, pref_x, pref_z, hip_x, hip_z, other_legs, w, cell,
-                    terms):
-    """Fill ``terms[:5]`` with the footprint goodnesses of cell p; False if a leg crossing."""
-    d = math.hypot(x - pref_x, z - pref_z)
-    terms[0] = max(0.0, 1.0 - d / w[W_DISTANCE_SCALE])
+def footprint_features(p, x, z, elev_dil, elev_raw, prox_dt, wp, pref_x, pref_z, hip_x, hip_z, other_legs, cell,
+                       features):
+    """Fill ``features[:5]`` (FEAT_* order) with the raw footprint features of cell p; False if
+    the leg hip -> (x, z) crosses another leg (the cell is refused outright, no features)."""
+    features[FEAT_DISTANCE] = math.hypot(x - pref_x, z - pref_z)
     e = elev_dil[p]
     rough = 0.0
     for q in (p - wp - 1, p - wp, p - wp + 1, p - 1, p + 1, p + wp - 1, p + wp, p + wp + 1):
         rough = max(rough, abs(elev_raw[q] - e))
-    terms[1] = max(0.0, 1.0 - rough / w[W_STEP_CRITICAL])
+    features[FEAT_ROUGHNESS] = rough
     gx = (elev_dil[p + 1] - elev_dil[p - 1]) / (2.0 * cell)
     gz = (elev_dil[p + wp] - elev_dil[p - wp]) / (2.0 * cell)
-    terms[2] = max(0.0, 1.0 - math.atan(math.hypot(gx, gz)) / w[W_SLOPE_CRITICAL])
+    features[FEAT_SLOPE] = math.atan(math.hypot(gx, gz))
     gap = np.inf
     for j in range(other_legs.shape[0]):
         hx = other_legs[j, 0]
@@ -169,17 +194,37 @@ def footprint_terms(p, x, z, code, elev_dil, elev_raw, prox_dt, wp, pref_x, pref
         fx = other_legs[j, 2]
         fz = other_legs[j, 3]
         if segments_cross(hip_x, hip_z, x, z, hx, hz, fx, fz):
-            terms[3] = 0.0
-            terms[4] = 0.0
             return False
         gap = min(gap, segment_point_distance(x, z, hx, hz, fx, fz), segment_point_distance(fx, fz, hip_x, hip_z, x, z))
-    terms[3] = min(1.0, gap / w[W_LEG_SPACING_REF])
-    terms[4] = min(1.0, prox_dt[p] / w[W_PROXIMITY_REF])
+    features[FEAT_LEG_GAP] = gap
+    features[FEAT_PROXIMITY] = prox_dt[p]
     return True
 
 
 @nb.njit(cache=True)
+def footprint_goodness(w, features, terms):
+    """Fill ``terms[:5]`` with the footprint goodnesses in [0, 1] of raw features (the one
+    definition: the search, the harvest and tuning/_scoring.py follow it term by term)."""
+    terms[0] = max(0.0, 1.0 - features[FEAT_DISTANCE] / w[W_DISTANCE_SCALE])
+    terms[1] = max(0.0, 1.0 - features[FEAT_ROUGHNESS] / w[W_STEP_CRITICAL])
+    terms[2] = max(0.0, 1.0 - features[FEAT_SLOPE] / w[W_SLOPE_CRITICAL])
+    terms[3] = min(1.0, features[FEAT_LEG_GAP] / w[W_LEG_SPACING_REF])
+    terms[4] = min(1.0, features[FEAT_PROXIMITY] / w[W_PROXIMITY_REF])
+
+
+@nb.njit(cache=True)
+def trajectory_goodness(w, terms, d_ref, length, curvature, clearance, climb, jerk):
+    """Fill ``terms[5:10]`` with the trajectory goodnesses in [0, 1] of raw trajectory metrics."""
+    terms[N_FOOTPRINT_TERMS + 0] = d_ref / max(length, d_ref)
+    terms[N_FOOTPRINT_TERMS + 1] = 1.0 / (1.0 + curvature / w[W_CURVATURE_REF])
+    terms[N_FOOTPRINT_TERMS + 2] = min(1.0, clearance / w[W_CLEARANCE_REF])
+    terms[N_FOOTPRINT_TERMS + 3] = 1.0 / (1.0 + climb / w[W_CLIMB_REF])
+    terms[N_FOOTPRINT_TERMS + 4] = 1.0 / (1.0 + jerk / w[W_JERK_REF])
+
+
+@nb.njit(cache=True)
 def weighted_mean(w, terms, lo, hi):
+    """sum_k w_k terms_k / sum_k w_k over k in [lo, hi), summed in index order (0 if no weight)."""
     num = 0.0
     den = 0.0
     for k in range(lo, hi):
@@ -193,8 +238,8 @@ def footprint_candidates(code, elev_dil, elev_raw, r0, c0, hp, wp, origin_x, ori
                          radius, hip_x, hip_z, reach_xz, other_legs, w):
     """Potential footprints (§5.1): free cells in the disc, within reach, no leg crossing.
 
-    Returns (cells, terms (n, 5), scores) sorted by descending footprint score, ties
-    by ascending padded index (deterministic).
+    Returns (cells, terms (n, 5), scores, features (n, 5)) sorted by descending
+    footprint score, ties by ascending padded index (deterministic).
     """
     n = hp * wp
     seed = np.zeros(n, dtype=np.uint8)
@@ -208,8 +253,10 @@ def footprint_candidates(code, elev_dil, elev_raw, r0, c0, hp, wp, origin_x, ori
     chamfer_distance(seed, inside, hp, wp, cell, prox_dt)
     cells = np.empty(n, dtype=np.int64)
     terms = np.empty((n, N_FOOTPRINT_TERMS), dtype=np.float64)
+    features = np.empty((n, N_FEATURES), dtype=np.float64)
     scores = np.empty(n, dtype=np.float64)
     buf = np.empty(N_TERMS, dtype=np.float64)
+    feat = np.empty(N_FEATURES, dtype=np.float64)
     m = 0
     for rr in range(1, hp - 1):
         for cc in range(1, wp - 1):
@@ -221,16 +268,18 @@ def footprint_candidates(code, elev_dil, elev_raw, r0, c0, hp, wp, origin_x, ori
                 continue
             if math.hypot(x - hip_x, z - hip_z) > reach_xz:
                 continue
-            if not footprint_terms(p, x, z, code, elev_dil, elev_raw, prox_dt, wp, pref_x, pref_z, hip_x, hip_z,
-                                   other_legs, w, cell, buf):
+            if not footprint_features(p, x, z, elev_dil, elev_raw, prox_dt, wp, pref_x, pref_z, hip_x, hip_z,
+                                      other_legs, cell, feat):
                 continue
+            footprint_goodness(w, feat, buf)
             cells[m] = p
             for k in range(N_FOOTPRINT_TERMS):
                 terms[m, k] = buf[k]
+                features[m, k] = feat[k]
             scores[m] = weighted_mean(w, buf, 0, N_FOOTPRINT_TERMS)
             m += 1
     order = np.argsort(-scores[:m], kind="mergesort")
-    return cells[:m][order].copy(), terms[:m][order].copy(), scores[:m][order].copy()
+    return cells[:m][order].copy(), terms[:m][order].copy(), scores[:m][order].copy(), features[:m][order].copy()
 
 
 @nb.njit(cache=True)
@@ -657,3 +706,32 @@ def path_length_3d(poly, n):
         dz = poly[i, 2] - poly[i - 1, 2]
         total += math.sqrt(dx * dx + dy * dy + dz * dz)
     return total
+
+
+@nb.njit(cache=True)
+def couple_metrics_2d(parent, passable, dt, elev_dil, source_p, target_p, source_x, source_y, source_z, target_y,
+                      step_height, r0, c0, hp, wp, origin_x, origin_z, cell, dense, dense_p, rows, cols):
+    """The 2D part of a (target, slice) couple: the path from the slice's wavefront tree, its
+    2D metrics, and the 2D climb over the elevations under the path (the 3D trajectory stays
+    above them, so climb_3d >= climb_2d, and with length_3d >= length_2d, score_3d <= score_2d).
+    Returns (n_dense, length_2d, curvature, clearance, climb_2d); n_dense < 2: no path."""
+    kept = naive_and_kept_points(parent, source_p, target_p, source_x, source_z, passable, r0, c0, hp, wp, origin_x,
+                                 origin_z, cell, rows, cols)
+    nd, len2, curv, clear = path_2d(kept, passable, dt, elev_dil, source_p, r0, c0, hp, wp, origin_x, origin_z, cell,
+                                    dense, dense_p, rows, cols)
+    if nd < 2:
+        return nd, 0.0, 0.0, 0.0, 0.0
+    ground_top = -np.inf
+    for i in range(1, nd - 1):
+        ground_top = max(ground_top, dense[i, 2])
+    base = max(source_y, target_y) + step_height
+    return nd, len2, curv, clear, max(0.0, ground_top - base)
+
+
+@nb.njit(cache=True)
+def couple_metrics_3d(dense, nd, len2, source_y, target_y, step_height, obstacle_margin, cell, poly, jerk_work):
+    """The 3D part of a couple whose 2D part filled ``dense``: the trajectory in ``poly``.
+    Returns (length_3d, climb_3d, jerk)."""
+    top = elevate_3d(dense, nd, len2, source_y, target_y, step_height, obstacle_margin, cell, poly)
+    base = max(source_y, target_y) + step_height
+    return path_length_3d(poly, nd), max(0.0, top - base), geometric_jerk(poly, nd, jerk_work)

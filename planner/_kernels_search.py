@@ -24,6 +24,13 @@ Search (``MODE_SEARCH``)
 ``MODE_PER_TARGET`` is the same search with one wavefront per (target, slice)
 (for benchmarks); ``MODE_BRUTE_FORCE`` scores every (target, slice) couple in
 3D with no pruning (the reference the tests compare the search with).
+
+Harvest (:func:`harvest_foot_kernel`, for tuning/)
+    every (target, slice) couple in 3D with no pruning, like ``MODE_BRUTE_FORCE``,
+    but returns them all: per candidate its raw features and goodnesses, per
+    couple its raw trajectory metrics, goodnesses and scores. It reuses the
+    search's pieces (``foot_setup``, ``couple_metrics_2d/3d``, the goodness
+    functions of :mod:`planner._kernels_foot`), so its numbers are the search's.
 """
 
 from __future__ import annotations
@@ -50,21 +57,19 @@ from planner._kernels_foot import (
     RAW_CURVATURE,
     RAW_JERK,
     RAW_LENGTH,
-    elevate_3d,
+    couple_metrics_2d,
+    couple_metrics_3d,
     footprint_candidates,
-    geometric_jerk,
-    naive_and_kept_points,
-    path_2d,
-    path_length_3d,
     prepare_foot,
     resample_by_arclength,
     slice_levels,
     slice_maps,
+    trajectory_goodness,
     weighted_mean,
 )
 from planner._kernels_wavefront import wavefront
 from planner._params import C_CELL, C_MARGIN, C_OBST_MARGIN, C_POT_GAIN, C_POT_RANGE, C_RADIUS, C_SAMPLES, C_SLICE_EPS
-from planner._weights import N_FOOTPRINT_TERMS, N_TERMS, W_CLEARANCE_REF, W_CLIMB_REF, W_CURVATURE_REF, W_JERK_REF
+from planner._weights import N_FOOTPRINT_TERMS, N_TERMS
 
 MODE_SEARCH = 0
 MODE_PER_TARGET = 1
@@ -74,13 +79,34 @@ SCORE_COUPLE, SCORE_FOOTPRINT, SCORE_TRAJECTORY = range(3)
 
 
 @nb.njit(cache=True)
-def _trajectory_terms(w, terms, d_ref, length, curvature, clearance, climb, jerk):
-    terms[N_FOOTPRINT_TERMS + 0] = d_ref / max(length, d_ref)
-    terms[N_FOOTPRINT_TERMS + 1] = 1.0 / (1.0 + curvature / w[W_CURVATURE_REF])
-    terms[N_FOOTPRINT_TERMS + 2] = min(1.0, clearance / w[W_CLEARANCE_REF])
-    terms[N_FOOTPRINT_TERMS + 3] = 1.0 / (1.0 + climb / w[W_CLIMB_REF])
-    terms[N_FOOTPRINT_TERMS + 4] = 1.0 / (1.0 + jerk / w[W_JERK_REF])
-    return weighted_mean(w, terms, 0, N_TERMS)
+def foot_setup(elevation, ground, forbidden, origin_x, origin_z, offsets, source, preferred, hip, reach_xz, other_legs,
+               feet_block_radius, w, cfg, slice_size):
+    """ROI maps, potential footprints, slices and d_ref of one foot (shared by the search and the
+    harvest). Returns (code, elev_dil, boxh_dil, r0, c0, hp, wp, source_p, cand, cand_terms,
+    cand_scores, cand_features, cand_rc, levels, d_ref)."""
+    cell = cfg[C_CELL]
+    radius = cfg[C_RADIUS]
+    pref_x = preferred[0]
+    pref_z = preferred[1]
+    code, elev_dil, boxh_dil, elev_raw, r0, c0, hp, wp = prepare_foot(
+        elevation, ground, forbidden, origin_x, origin_z, cell, offsets, source[0], source[2], pref_x, pref_z, radius,
+        int(cfg[C_MARGIN]), other_legs, feet_block_radius)
+    sr, sc = cell_of(source[0], source[2], origin_x, origin_z, cell)
+    source_p = (sr - r0 + 1) * wp + (sc - c0 + 1)
+    cand, cand_terms, cand_scores, cand_features = footprint_candidates(
+        code, elev_dil, elev_raw, r0, c0, hp, wp, origin_x, origin_z, cell, source_p, pref_x, pref_z, radius,
+        hip[0], hip[1], reach_xz, other_legs, w)
+    n_cand = cand.size
+    cand_rc = np.empty((n_cand, 2), dtype=np.int64)
+    for k in range(n_cand):
+        rr = cand[k] // wp
+        cand_rc[k, 0] = r0 - 1 + rr
+        cand_rc[k, 1] = c0 - 1 + (cand[k] - rr * wp)
+    levels = slice_levels(code, boxh_dil, slice_size, cfg[C_SLICE_EPS])
+    # The length goodness's reference: the source -> preferred distance (at least a cell).
+    d_ref = max(math.hypot(pref_x - source[0], pref_z - source[2]), cell)
+    return (code, elev_dil, boxh_dil, r0, c0, hp, wp, source_p, cand, cand_terms, cand_scores, cand_features, cand_rc,
+            levels, d_ref)
 
 
 @nb.njit(cache=True)
@@ -94,38 +120,23 @@ def plan_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, 
      candidate_scores (n,))
     """
     cell = cfg[C_CELL]
-    radius = cfg[C_RADIUS]
     eps = cfg[C_SLICE_EPS]
     k_out = int(cfg[C_SAMPLES])
     source_x = source[0]
     source_y = source[1]
     source_z = source[2]
-    pref_x = preferred[0]
-    pref_z = preferred[1]
     counters = np.zeros(N_COUNTERS, dtype=np.int64)
-    code, elev_dil, boxh_dil, elev_raw, r0, c0, hp, wp = prepare_foot(
-        elevation, ground, forbidden, origin_x, origin_z, cell, offsets, source_x, source_z, pref_x, pref_z, radius,
-        int(cfg[C_MARGIN]), other_legs, feet_block_radius)
+    (code, elev_dil, boxh_dil, r0, c0, hp, wp, source_p, cand, cand_terms, cand_scores, _, cand_rc, levels,
+     d_ref) = foot_setup(elevation, ground, forbidden, origin_x, origin_z, offsets, source, preferred, hip, reach_xz,
+                         other_legs, feet_block_radius, w, cfg, slice_size)
     n = hp * wp
-    sr, sc = cell_of(source_x, source_z, origin_x, origin_z, cell)
-    source_p = (sr - r0 + 1) * wp + (sc - c0 + 1)
-    cand, cand_terms, cand_scores = footprint_candidates(
-        code, elev_dil, elev_raw, r0, c0, hp, wp, origin_x, origin_z, cell, source_p, pref_x, pref_z, radius,
-        hip[0], hip[1], reach_xz, other_legs, w)
     n_cand = cand.size
     counters[CNT_CANDIDATES] = n_cand
-    cand_rc = np.empty((n_cand, 2), dtype=np.int64)
-    for k in range(n_cand):
-        rr = cand[k] // wp
-        cand_rc[k, 0] = r0 - 1 + rr
-        cand_rc[k, 1] = c0 - 1 + (cand[k] - rr * wp)
-    levels = slice_levels(code, boxh_dil, slice_size, eps)
     n_slices = levels.size
     counters[CNT_SLICES] = n_slices
 
     # Exact bound: a candidate's couple score cannot exceed its footprint part plus
     # perfect trajectory goodnesses (length bounded by the straight-line distance).
-    d_ref = max(math.hypot(pref_x - source_x, pref_z - source_z), cell)
     w_all = 0.0
     for k in range(N_TERMS):
         w_all += w[k]
@@ -203,28 +214,23 @@ def plan_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, 
                 counters[CNT_WAVEFRONTS] += 1
             if not math.isfinite(dist[s, tp]):
                 continue
-            kept = naive_and_kept_points(parent[s], source_p, tp, source_x, source_z, passable[s], r0, c0, hp, wp,
-                                         origin_x, origin_z, cell, rows, cols)
-            nd, len2, curv, clear = path_2d(kept, passable[s], dt[s], elev_dil, source_p, r0, c0, hp, wp, origin_x,
-                                            origin_z, cell, dense, dense_p, rows, cols)
+            nd, len2, curv, clear, climb2 = couple_metrics_2d(
+                parent[s], passable[s], dt[s], elev_dil, source_p, tp, source_x, source_y, source_z, target_y,
+                step_height, r0, c0, hp, wp, origin_x, origin_z, cell, dense, dense_p, rows, cols)
             if nd < 2:
                 continue
             counters[CNT_COUPLES_2D] += 1
             for t in range(N_FOOTPRINT_TERMS):
                 terms[t] = cand_terms[k, t]
-            ground_top = -np.inf
-            for i in range(1, nd - 1):
-                ground_top = max(ground_top, dense[i, 2])
-            base = max(source_y, target_y) + step_height
-            climb2 = max(0.0, ground_top - base)
-            score2 = _trajectory_terms(w, terms, d_ref, len2, curv, clear, climb2, 0.0)
+            # 2D score: jerk at its best case (goodness 1), 2D length and climb (see module doc).
+            trajectory_goodness(w, terms, d_ref, len2, curv, clear, climb2, 0.0)
+            score2 = weighted_mean(w, terms, 0, N_TERMS)
             if mode != MODE_BRUTE_FORCE and score2 <= best_score:
                 continue
-            top = elevate_3d(dense, nd, len2, source_y, target_y, step_height, cfg[C_OBST_MARGIN], cell, poly)
-            len3 = path_length_3d(poly, nd)
-            climb3 = max(0.0, top - base)
-            jerk = geometric_jerk(poly, nd, jerk_work)
-            score3 = _trajectory_terms(w, terms, d_ref, len3, curv, clear, climb3, jerk)
+            len3, climb3, jerk = couple_metrics_3d(dense, nd, len2, source_y, target_y, step_height,
+                                                   cfg[C_OBST_MARGIN], cell, poly, jerk_work)
+            trajectory_goodness(w, terms, d_ref, len3, curv, clear, climb3, jerk)
+            score3 = weighted_mean(w, terms, 0, N_TERMS)
             counters[CNT_COUPLES_3D] += 1
             evaluated_3d = True
             if first_found:
@@ -283,3 +289,93 @@ def plan_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, 
         level = np.nan
     return (valid, target_rc, target_xyz, best_s, level, scores, best_terms, best_raw, counters, trajectory, cand_rc,
             cand_scores)
+
+
+@nb.njit(cache=True)
+def harvest_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, source, preferred, hip, reach_xz,
+                        step_height, other_legs, feet_block_radius, w, cfg, slice_size):
+    """Every candidate couple of one foot (see the module docstring). Returns
+
+    (cand_rc (n, 2), cand_xyz (n, 3) target points, cand_features (n, 5) FEAT_* order,
+     cand_terms (n, 5), cand_scores (n,), levels (S,), d_ref, couple_valid (n, S) bool,
+     couple_raw (n, S, 5) RAW_* order, couple_terms (n, S, 10), couple_scores (n, S, 3)
+     SCORE_* order)
+
+    Candidates are in the search's order (descending footprint score), slices too, so
+    the first maximum of ``couple_scores[..., SCORE_COUPLE]`` in row-major order is the
+    couple the exhaustive search picks.
+    """
+    cell = cfg[C_CELL]
+    eps = cfg[C_SLICE_EPS]
+    source_x = source[0]
+    source_y = source[1]
+    source_z = source[2]
+    (code, elev_dil, boxh_dil, r0, c0, hp, wp, source_p, cand, cand_terms, cand_scores, cand_features, cand_rc, levels,
+     d_ref) = foot_setup(elevation, ground, forbidden, origin_x, origin_z, offsets, source, preferred, hip, reach_xz,
+                         other_legs, feet_block_radius, w, cfg, slice_size)
+    n = hp * wp
+    n_cand = cand.size
+    n_slices = levels.size
+    cand_xyz = np.empty((n_cand, 3), dtype=np.float64)
+    for k in range(n_cand):
+        x, z = cell_centre(cand_rc[k, 0], cand_rc[k, 1], origin_x, origin_z, cell)
+        cand_xyz[k, 0] = x
+        cand_xyz[k, 1] = elev_dil[cand[k]]
+        cand_xyz[k, 2] = z
+    couple_valid = np.zeros((n_cand, n_slices), dtype=np.bool_)
+    couple_raw = np.zeros((n_cand, n_slices, N_RAW), dtype=np.float64)
+    couple_terms = np.zeros((n_cand, n_slices, N_TERMS), dtype=np.float64)
+    couple_scores = np.zeros((n_cand, n_slices, 3), dtype=np.float64)
+    passable = np.empty(n, dtype=np.uint8)
+    factor = np.empty(n, dtype=np.float64)
+    dt = np.empty(n, dtype=np.float64)
+    dist = np.empty(n, dtype=np.float64)
+    parent = np.empty(n, dtype=np.int64)
+    stop = np.empty(max(n_cand, 1), dtype=np.int64)
+    cap = 4 * (hp + wp) + 8
+    rows = np.empty(cap, dtype=np.int64)
+    cols = np.empty(cap, dtype=np.int64)
+    dense = np.empty((MAX_DENSE, 3), dtype=np.float64)
+    dense_p = np.empty(MAX_DENSE, dtype=np.int64)
+    poly = np.empty((MAX_DENSE, 3), dtype=np.float64)
+    jerk_work = np.empty((JERK_SAMPLES, 3), dtype=np.float64)
+    terms = np.empty(N_TERMS, dtype=np.float64)
+    for s in range(n_slices):
+        m = 0
+        for q in range(n_cand):
+            if boxh_dil[cand[q]] <= levels[s] + eps:
+                stop[m] = cand[q]
+                m += 1
+        if m == 0:
+            continue
+        slice_maps(code, boxh_dil, levels[s], eps, source_p, hp, wp, cell, cfg[C_POT_RANGE], cfg[C_POT_GAIN],
+                   passable, factor, dt)
+        wavefront(passable, factor, wp, source_p, cell, stop[:m], dist, parent)
+        for k in range(n_cand):
+            tp = cand[k]
+            if boxh_dil[tp] > levels[s] + eps or not math.isfinite(dist[tp]):
+                continue
+            target_y = elev_dil[tp]
+            nd, len2, curv, clear, climb2 = couple_metrics_2d(
+                parent, passable, dt, elev_dil, source_p, tp, source_x, source_y, source_z, target_y, step_height,
+                r0, c0, hp, wp, origin_x, origin_z, cell, dense, dense_p, rows, cols)
+            if nd < 2:
+                continue
+            len3, climb3, jerk = couple_metrics_3d(dense, nd, len2, source_y, target_y, step_height,
+                                                   cfg[C_OBST_MARGIN], cell, poly, jerk_work)
+            for t in range(N_FOOTPRINT_TERMS):
+                terms[t] = cand_terms[k, t]
+            trajectory_goodness(w, terms, d_ref, len3, curv, clear, climb3, jerk)
+            couple_valid[k, s] = True
+            couple_raw[k, s, RAW_LENGTH] = len3
+            couple_raw[k, s, RAW_CURVATURE] = curv
+            couple_raw[k, s, RAW_CLEARANCE] = clear
+            couple_raw[k, s, RAW_CLIMB] = climb3
+            couple_raw[k, s, RAW_JERK] = jerk
+            for t in range(N_TERMS):
+                couple_terms[k, s, t] = terms[t]
+            couple_scores[k, s, SCORE_COUPLE] = weighted_mean(w, terms, 0, N_TERMS)
+            couple_scores[k, s, SCORE_FOOTPRINT] = cand_scores[k]
+            couple_scores[k, s, SCORE_TRAJECTORY] = weighted_mean(w, terms, N_FOOTPRINT_TERMS, N_TERMS)
+    return (cand_rc, cand_xyz, cand_features, cand_terms, cand_scores, levels, d_ref, couple_valid, couple_raw,
+            couple_terms, couple_scores)

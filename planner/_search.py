@@ -99,6 +99,16 @@ class CoupleResult:
     candidate_scores: np.ndarray  # (n,)
 
 
+def checked_foot_offsets(maps: LocalMaps, query: FootQuery, config: PlannerConfig) -> np.ndarray:
+    """Check that ``maps`` and ``query`` fit ``config``; the foot-shape stencil (cell offsets)."""
+    if abs(maps.frame.cell_size - config.cell_size) > 1e-12:
+        raise ValueError(f"maps: cell size {maps.frame.cell_size} differs from config.cell_size {config.cell_size}")
+    r, c = maps.frame.world_to_cell(query.source[0], query.source[2])
+    if not maps.frame.contains_cell(r, c):
+        raise ValueError("query.source: outside the local maps")
+    return foot_offsets(query.foot_length, query.foot_width, query.foot_yaw, config.cell_size)
+
+
 def plan_foot(maps: LocalMaps, query: FootQuery, weights: ScoringWeights | None = None,
               budget: SearchBudget = DEFAULT_BUDGET, config: PlannerConfig | None = None,
               mode: str = "search") -> CoupleResult:
@@ -108,12 +118,7 @@ def plan_foot(maps: LocalMaps, query: FootQuery, weights: ScoringWeights | None 
     config = config or PlannerConfig()
     if mode not in MODES:
         raise ValueError(f"mode: expected one of {sorted(MODES)}, got {mode!r}")
-    if abs(maps.frame.cell_size - config.cell_size) > 1e-12:
-        raise ValueError(f"maps: cell size {maps.frame.cell_size} differs from config.cell_size {config.cell_size}")
-    r, c = maps.frame.world_to_cell(query.source[0], query.source[2])
-    if not maps.frame.contains_cell(r, c):
-        raise ValueError("query.source: outside the local maps")
-    offsets = foot_offsets(query.foot_length, query.foot_width, query.foot_yaw, config.cell_size)
+    offsets = checked_foot_offsets(maps, query, config)
     couples_after_first, slice_size, early = budget.kernel_args()
     out = plan_foot_kernel(
         maps.elevation, maps.ground, maps.forbidden, maps.frame.origin_x, maps.frame.origin_z, offsets,

@@ -1,1 +1,75 @@
-"""Tuning of the scoring weights with JAX and optimistix (not built yet: issue 4)."""
+"""Tuning of the scoring weights and the gait timing with JAX (issue 4).
+
+* :mod:`tuning._scoring`: the runtime's goodnesses and scores, exactly, from the
+  harvest's raw numbers (``planner.harvest_situations``).
+* :mod:`tuning._proxies`: a soft selection (temperature tau) over the harvested
+  couples: expected step length, curvature energy, clearance, climb, jerk as
+  smooth functions of the weights and of the gait-timing parameters.
+* :mod:`tuning._targets`: biomechanics targets with their citations
+  (``tuning/data/targets.toml``), per creature, normalised by its leg length.
+* :mod:`tuning._fit`: Levenberg-Marquardt (optimistix) on the target residuals,
+  log-parametrised weights and timing, the steps as one ``lax.scan``.
+
+tuning/ computes in float64: its entry points call :func:`enable_x64`.
+"""
+
+from tuning._config import enable_x64
+from tuning._fit import FITTED_TIMING, FitProblem, fit, loss, make_problem, residuals
+from tuning._proxies import (
+    PROXY_METRICS,
+    Situations,
+    couple_scores,
+    duty_factor,
+    expected_metrics,
+    hard_metrics,
+    preferred_footprint,
+    preferred_lead_time,
+    situations_from_harvest,
+    soft_selection,
+    stride_frequency,
+    stride_length,
+)
+from tuning._targets import QUANTITIES, TARGETS_FILE, CreatureTargets, Target, load_targets
+from tuning._scoring import (
+    couple_score,
+    couple_terms,
+    footprint_goodness,
+    footprint_score,
+    trajectory_goodness,
+    trajectory_score,
+    weighted_mean,
+)
+
+__all__ = [
+    "FITTED_TIMING",
+    "FitProblem",
+    "fit",
+    "loss",
+    "make_problem",
+    "residuals",
+    "PROXY_METRICS",
+    "QUANTITIES",
+    "TARGETS_FILE",
+    "CreatureTargets",
+    "Target",
+    "load_targets",
+    "Situations",
+    "couple_score",
+    "couple_scores",
+    "couple_terms",
+    "duty_factor",
+    "enable_x64",
+    "expected_metrics",
+    "footprint_goodness",
+    "footprint_score",
+    "hard_metrics",
+    "preferred_footprint",
+    "preferred_lead_time",
+    "situations_from_harvest",
+    "soft_selection",
+    "stride_frequency",
+    "stride_length",
+    "trajectory_goodness",
+    "trajectory_score",
+    "weighted_mean",
+]

@@ -1,0 +1,279 @@
+"""Harvest for tuning (issue 4): every couple the search could pick, with its raw numbers.
+
+The runtime search returns one couple per foot. Tuning needs, per planning
+situation, the whole choice set: per candidate footprint its raw features
+(FEATURES), per (candidate, slice) couple its raw trajectory metrics
+(RAW_METRICS) and ``d_ref``, and which couple the runtime picked. The numbers come
+from :func:`planner._kernels_search.harvest_foot_kernel`, which uses the search's
+own goodness and scoring functions, so the runtime's scores are stored alongside
+(tuning/ recomputes them from the raw numbers and must find the same values).
+
+* :func:`harvest_foot`: one foot (``LocalMaps`` + ``FootQuery``), validated.
+* :func:`harvest_situations`: short seeded crowd runs (``init_crowd`` / ``step``)
+  over built-in scenarios and creatures; every planning request of every frame
+  becomes a situation. Struct-of-arrays, padded to the largest candidate and
+  slice counts, with masks. Deterministic for a seed.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+
+from planner._kernels_foot import N_FEATURES, N_RAW
+from planner._kernels_geometry import foot_offsets
+from planner._kernels_search import MODE_SEARCH, harvest_foot_kernel, plan_foot_kernel
+from planner._maps import LocalMaps
+from planner._params import DEFAULT_BUDGET, PlannerConfig, SearchBudget
+from planner._search import FootQuery, checked_foot_offsets
+from planner._weights import N_FOOTPRINT_TERMS, N_TERMS, ScoringWeights
+
+FEATURES = ("distance_m", "roughness_m", "slope_rad", "leg_gap_m", "obstacle_distance_m")
+"""Raw footprint features, in the order of ``cand_features`` (FEAT_* of planner._kernels_foot)."""
+assert len(FEATURES) == N_FEATURES
+# Request kinds of the crowd (planner._crowd.stage_requests).
+KIND_NEW_SWING, KIND_FORCED_STEP, KIND_REPLAN = 1, 2, 3
+
+
+@dataclass(frozen=True)
+class FootHarvest:
+    """All couples of one foot. n candidates (the search's order), S slices."""
+
+    cand_cells: np.ndarray  # (n, 2) local (row, col)
+    cand_xyz: np.ndarray  # (n, 3) target points (cell centre, dilated elevation)
+    cand_features: np.ndarray  # (n, 5) FEATURES
+    cand_terms: np.ndarray  # (n, 5) footprint goodnesses (the runtime's)
+    cand_scores: np.ndarray  # (n,) footprint scores (the runtime's)
+    levels: np.ndarray  # (S,) slice levels, m above terrain (inf: no slices)
+    d_ref: float  # m, reference of the length goodness
+    couple_valid: np.ndarray  # (n, S) bool: a path exists
+    couple_raw: np.ndarray  # (n, S, 5) RAW_METRICS
+    couple_terms: np.ndarray  # (n, S, 10) goodnesses (the runtime's)
+    couple_scores: np.ndarray  # (n, S, 3) couple, footprint, trajectory scores (the runtime's)
+
+
+def _harvest_kernel_call(elevation, ground, forbidden, origin_x, origin_z, offsets, source, preferred, hip, reach_xz,
+                         step_height, legs, block_radius, w, cfg, slice_size) -> FootHarvest:
+    out = harvest_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, source, preferred, hip,
+                              reach_xz, step_height, legs, block_radius, w, cfg, slice_size)
+    rc, xyz, feats, terms, scores, levels, d_ref, valid, raw, cterms, cscores = out
+    return FootHarvest(rc, xyz, feats, terms, scores, levels, float(d_ref), valid, raw, cterms, cscores)
+
+
+def harvest_foot(maps: LocalMaps, query: FootQuery, weights: ScoringWeights | None = None,
+                 budget: SearchBudget = DEFAULT_BUDGET, config: PlannerConfig | None = None) -> FootHarvest:
+    """Every (candidate, slice) couple of one foot, scored in 3D (the budget gives only the slice size)."""
+    weights = weights or ScoringWeights()
+    config = config or PlannerConfig()
+    offsets = checked_foot_offsets(maps, query, config)
+    _, slice_size, _ = budget.kernel_args()
+    return _harvest_kernel_call(maps.elevation, maps.ground, maps.forbidden, maps.frame.origin_x, maps.frame.origin_z,
+                                offsets, query.source, query.preferred, query.hip, float(query.reach_xz),
+                                float(query.step_height), query.other_legs, query.feet_block_radius,
+                                weights.to_array(), config.to_array(), slice_size)
+
+
+@dataclass(frozen=True)
+class Harvest:
+    """Planning situations (F) of seeded crowd runs, padded to K candidates and S slices.
+
+    Per situation: where it came from, the kinematics the timing model needs
+    (tuning/_proxies.py moves the preferred footprint with the timing parameters),
+    the candidate set, and the exhaustive search's pick (``chosen``: (k, s) or
+    (-1, -1) when no couple exists) with its scores, goodnesses and raw metrics.
+    ``crowd_choice`` is the couple the crowd's own (budgeted) search took.
+    """
+
+    creatures: tuple[str, ...]
+    scenarios: tuple[str, ...]
+    creature: np.ndarray  # (F,) index into creatures
+    scenario: np.ndarray  # (F,) index into scenarios
+    seed: np.ndarray  # (F,)
+    frame: np.ndarray  # (F,)
+    character: np.ndarray  # (F,)
+    leg: np.ndarray  # (F,)
+    kind: np.ndarray  # (F,) KIND_*
+    leg_height: np.ndarray  # (F,) m, h of the Froude number (planner._timing.hip_height)
+    speed: np.ndarray  # (F,) m/s, the character's speed when it planned
+    forward: np.ndarray  # (F, 2) unit heading (x, z)
+    relative_swing: np.ndarray  # (F,) the leg's authored swing duration / mean over the legs
+    source: np.ndarray  # (F, 3)
+    preferred: np.ndarray  # (F, 2)
+    cell_size: np.ndarray  # (F,) m
+    d_ref: np.ndarray  # (F,) m
+    cand_mask: np.ndarray  # (F, K) bool
+    cand_xyz: np.ndarray  # (F, K, 3)
+    cand_features: np.ndarray  # (F, K, 5) FEATURES
+    cand_terms: np.ndarray  # (F, K, 5)
+    cand_scores: np.ndarray  # (F, K)
+    couple_mask: np.ndarray  # (F, K, S) bool
+    couple_raw: np.ndarray  # (F, K, S, 5) RAW_METRICS
+    couple_terms: np.ndarray  # (F, K, S, 10)
+    couple_scores: np.ndarray  # (F, K, S, 3)
+    chosen: np.ndarray  # (F, 2) int
+    chosen_scores: np.ndarray  # (F, 3)
+    chosen_terms: np.ndarray  # (F, 10)
+    chosen_raw: np.ndarray  # (F, 5)
+    crowd_choice: np.ndarray  # (F, 2) int, (-1, -1) if the crowd's search found none
+    weights: np.ndarray  # ScoringWeights.to_array() the situations were scored with
+    timing: np.ndarray  # GaitTiming.to_array() of the runs
+
+    @property
+    def n_situations(self) -> int:
+        return int(self.kind.size)
+
+    @property
+    def has_couple(self) -> np.ndarray:
+        """(F,) bool: at least one couple exists (the softmax of tuning/ needs one)."""
+        return self.couple_mask.any(axis=(1, 2))
+
+
+def _row_of(cells: np.ndarray, levels_count: int, target_cell, slice_index: int) -> tuple[int, int]:
+    hit = np.flatnonzero((cells[:, 0] == target_cell[0]) & (cells[:, 1] == target_cell[1]))
+    if hit.size != 1 or not 0 <= slice_index < levels_count:
+        raise RuntimeError("harvest: the search's couple is not among the harvested ones")
+    return int(hit[0]), int(slice_index)
+
+
+def _harvest_batch(batch, weights, config, out, cs, ls, kinds, state, model, meta, rows) -> None:
+    """One plan_batch call of the crowd: harvest every foot, and run the exhaustive search on it."""
+    w = weights.to_array()
+    cfg = config.to_array()
+    lengths = np.asarray(state.gaits.gait_duration)
+    for i in range(batch.n_feet):
+        ch = int(batch.foot_char[i])
+        offsets = foot_offsets(batch.foot_shape[i, 0], batch.foot_shape[i, 1], batch.foot_shape[i, 2], config.cell_size)
+        legs = np.ascontiguousarray(batch.legs[batch.legs_start[i]:batch.legs_start[i + 1]])
+        args = (batch.elevation[ch], batch.ground[ch], batch.forbidden[ch], batch.origins[ch, 0], batch.origins[ch, 1],
+                offsets, batch.sources[i], batch.preferred[i], batch.hips[i], float(batch.reach_xz[i]),
+                float(batch.step_height[i]), legs, float(batch.block_radius[i]), w, cfg)
+        slice_size = float(batch.slice_size[i])
+        foot = _harvest_kernel_call(*args, slice_size)
+        # The exhaustive search (no couple limit, no early stop) on the same foot and slices.
+        best = plan_foot_kernel(*args, -1, slice_size, False, MODE_SEARCH)
+        chosen = (-1, -1)
+        if best[0]:
+            chosen = _row_of(foot.cand_cells, foot.levels.size, best[1], int(best[3]))
+        crowd = (-1, -1)
+        if out.valid[i]:
+            # The target is a cell centre: its local (row, col) is exact after flooring.
+            rc = np.floor((out.target[i, [2, 0]] - batch.origins[ch, ::-1]) / config.cell_size).astype(np.int64)
+            crowd = _row_of(foot.cand_cells, foot.levels.size, rc, int(out.slice_index[i]))
+        c, leg = int(cs[i]), int(ls[i])
+        rows.append(dict(
+            meta, frame=state.frame, character=c, leg=leg, kind=int(kinds[i]), leg_height=model.leg_height,
+            speed=float(state.speed[c]), forward=(math.cos(state.heading[c]), math.sin(state.heading[c])),
+            relative_swing=float(lengths[c, leg] / np.mean(lengths[c])), source=batch.sources[i].copy(),
+            preferred=batch.preferred[i].copy(), cell_size=config.cell_size, foot=foot, chosen=chosen,
+            chosen_scores=best[5].copy(), chosen_terms=best[6].copy(), chosen_raw=best[7].copy(), crowd_choice=crowd))
+
+
+def _pack(rows: list[dict], creatures, scenarios, weights: np.ndarray, timing: np.ndarray) -> Harvest:
+    f = len(rows)
+    k = max([r["foot"].cand_scores.size for r in rows] + [1])
+    s = max([r["foot"].levels.size for r in rows] + [1])
+    cand_mask = np.zeros((f, k), np.bool_)
+    cand_xyz = np.zeros((f, k, 3))
+    cand_features = np.zeros((f, k, N_FEATURES))
+    cand_terms = np.zeros((f, k, N_FOOTPRINT_TERMS))
+    cand_scores = np.zeros((f, k))
+    couple_mask = np.zeros((f, k, s), np.bool_)
+    couple_raw = np.zeros((f, k, s, N_RAW))
+    couple_terms = np.zeros((f, k, s, N_TERMS))
+    couple_scores = np.zeros((f, k, s, 3))
+    for i, r in enumerate(rows):
+        h = r["foot"]
+        n, m = h.cand_scores.size, h.levels.size
+        cand_mask[i, :n] = True
+        cand_xyz[i, :n] = h.cand_xyz
+        cand_features[i, :n] = h.cand_features
+        cand_terms[i, :n] = h.cand_terms
+        cand_scores[i, :n] = h.cand_scores
+        couple_mask[i, :n, :m] = h.couple_valid
+        couple_raw[i, :n, :m] = h.couple_raw
+        couple_terms[i, :n, :m] = h.couple_terms
+        couple_scores[i, :n, :m] = h.couple_scores
+
+    def col(name, dtype=np.float64):
+        return np.array([r[name] for r in rows], dtype=dtype)
+
+    return Harvest(
+        creatures=tuple(creatures), scenarios=tuple(scenarios), creature=col("creature", np.int64),
+        scenario=col("scenario", np.int64), seed=col("seed", np.int64), frame=col("frame", np.int64),
+        character=col("character", np.int64), leg=col("leg", np.int64), kind=col("kind", np.int64),
+        leg_height=col("leg_height"), speed=col("speed"), forward=col("forward").reshape(f, 2),
+        relative_swing=col("relative_swing"), source=col("source").reshape(f, 3),
+        preferred=col("preferred").reshape(f, 2), cell_size=col("cell_size"),
+        d_ref=np.array([r["foot"].d_ref for r in rows]), cand_mask=cand_mask, cand_xyz=cand_xyz,
+        cand_features=cand_features, cand_terms=cand_terms, cand_scores=cand_scores, couple_mask=couple_mask,
+        couple_raw=couple_raw, couple_terms=couple_terms, couple_scores=couple_scores,
+        chosen=col("chosen", np.int64).reshape(f, 2), chosen_scores=col("chosen_scores").reshape(f, 3),
+        chosen_terms=col("chosen_terms").reshape(f, N_TERMS), chosen_raw=col("chosen_raw").reshape(f, N_RAW),
+        crowd_choice=col("crowd_choice", np.int64).reshape(f, 2), weights=weights, timing=timing)
+
+
+def harvest_situations(scenarios=("mixed",), creatures=("spider",), *, seeds=(0,), frames: int = 30,
+                       n_characters: int = 2, weights: ScoringWeights | None = None, timing=None,
+                       max_situations: int | None = None) -> Harvest:
+    """Run ``frames`` frames of a seeded crowd (LOD off: the paper's full search) per scenario,
+    creature and seed, and harvest every planning request (module docstring).
+
+    Creatures use their default gait. Stops once ``max_situations`` situations are
+    collected (whole frames: the last frame's requests are all kept).
+    """
+    from planner._timing import GaitTiming
+
+    if isinstance(scenarios, str) or isinstance(creatures, str):
+        raise ValueError("scenarios, creatures: expected sequences of names")
+    if not scenarios or not creatures or not seeds:
+        raise ValueError("scenarios, creatures, seeds: expected at least one of each")
+    if isinstance(frames, bool) or not isinstance(frames, int) or frames < 1:
+        raise ValueError(f"frames: expected an integer >= 1, got {frames!r}")
+    if isinstance(n_characters, bool) or not isinstance(n_characters, int) or n_characters < 1:
+        raise ValueError(f"n_characters: expected an integer >= 1, got {n_characters!r}")
+    if max_situations is not None and (isinstance(max_situations, bool) or not isinstance(max_situations, int)
+                                       or max_situations < 1):
+        raise ValueError(f"max_situations: expected None or an integer >= 1, got {max_situations!r}")
+    weights = weights or ScoringWeights()
+    timing = timing or GaitTiming()
+    # A few characters plan a few feet per frame: fanning each small kernel call out over
+    # the cores costs more than it saves (x20 on a busy 2-core machine), and the parallel
+    # and serial kernels give identical results (tests/test_planner_properties.py).
+    threads = numba.get_num_threads()
+    numba.set_num_threads(1)
+    try:
+        return _run(scenarios, creatures, seeds, frames, n_characters, weights, timing, max_situations)
+    finally:
+        numba.set_num_threads(threads)
+
+
+def _run(scenarios, creatures, seeds, frames, n_characters, weights, timing, max_situations) -> Harvest:
+    from planner._crowd import init_crowd, planner_config_for, step
+    from planner._maps import WorldRaster
+    from scenarios import default_gait_name, load_creature, load_gait, load_scenario
+
+    rows: list[dict] = []
+    for ci, creature_name in enumerate(creatures):
+        creature = load_creature(creature_name)
+        gait = load_gait(default_gait_name(creature.name), creature)
+        cell = planner_config_for(creature).cell_size
+        for si, scenario_name in enumerate(scenarios):
+            scenario = load_scenario(scenario_name)
+            raster = WorldRaster.build(scenario.terrain, scenario.obstacles, cell)
+            for seed in seeds:
+                model, state = init_crowd(scenario, creature, gait, n_characters=n_characters, seed=int(seed),
+                                          weights=weights, timing=timing, lod_mode="off", raster=raster)
+                meta = {"creature": ci, "scenario": si, "seed": int(seed)}
+                for _ in range(frames):
+                    step(model, state)
+                    if state.last_plans is None:
+                        continue
+                    cs, ls, kinds, out = state.last_plans
+                    _harvest_batch(state.last_batch, model.weights, model.config, out, cs, ls, kinds, state, model,
+                                   meta, rows)
+                    if max_situations is not None and len(rows) >= max_situations:
+                        return _pack(rows, creatures, scenarios, weights.to_array(), timing.to_array())
+    return _pack(rows, creatures, scenarios, weights.to_array(), timing.to_array())

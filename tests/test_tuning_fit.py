@@ -1,0 +1,73 @@
+"""Fit (issue 4, item 4): Levenberg-Marquardt on the target residuals, positive parameters."""
+
+import numpy as np
+import pytest
+
+from planner import GaitTiming, ScoringWeights, harvest_situations
+from planner._timing import GRAVITY, TIMING_FIELDS
+
+N_STEPS = 6
+TAU = 0.05
+# The stride residual recomputed here from the same float64 numbers (one division order apart).
+RESIDUAL_ATOL = 1e-12
+
+
+@pytest.fixture(scope="module")
+def problem():
+    import tuning
+    from tuning import _fit
+
+    tuning.enable_x64()
+    harvest = harvest_situations(scenarios=("crates",), creatures=("spider", "ant"), seeds=(2,), frames=24,
+                                 n_characters=2)
+    situations = tuning.situations_from_harvest(harvest)
+    return _fit.make_problem(situations, harvest.creatures, tuning.load_targets(creatures=harvest.creatures), TAU)
+
+
+def test_the_stride_residuals_are_the_targets_law(problem):
+    import tuning
+    from tuning import _fit
+
+    s = problem.situations
+    r = np.asarray(_fit.residuals(_fit.initial_params(problem), problem))
+    mask = np.asarray(problem.stride_mask)
+    assert mask.sum() > 10
+    metrics = tuning.expected_metrics(s.weights0, s.timing0, s, TAU)
+    targets = tuning.load_targets(creatures=("spider", "ant"))
+    names = ("spider", "ant")
+    v = np.asarray(s.speed)
+    law = np.array([targets[names[c]].stride_length_m(x) for c, x in zip(np.asarray(s.creature), v)])
+    h = np.asarray(s.leg_height)
+    # lambda = 2.3 h Fr^0.3 (Alexander), by hand.
+    np.testing.assert_allclose(law, 2.3 * h * (v * v / (GRAVITY * h)) ** 0.3, rtol=1e-14)
+    tolerance = np.array([targets[names[c]]["stride_length"].values["relative_tolerance"]
+                          for c in np.asarray(s.creature)])
+    expected = (np.asarray(metrics["step_length_m"]) / law - 1.0) / tolerance / np.sqrt(mask.sum())
+    np.testing.assert_allclose(r[:s.n_situations][mask], expected[mask], rtol=0, atol=RESIDUAL_ATOL)
+    assert (r[:s.n_situations][~mask] == 0.0).all()
+
+
+def test_levenberg_marquardt_lowers_the_loss_and_keeps_parameters_valid(problem):
+    from tuning import _fit
+
+    loss0 = float(_fit.loss(_fit.initial_params(problem), problem))
+    weights, timing, history = _fit.fit(problem, n_steps=N_STEPS)
+    assert history.shape == (N_STEPS,) and np.isfinite(history).all()
+    assert history[-1] < loss0
+    assert (np.diff(history) <= 1e-12 * loss0).all()  # LM only accepts steps that lower the loss
+    assert (weights > 0).all() and np.isfinite(weights).all()
+    ScoringWeights.from_array(weights)  # validated: positive weights and scales
+    fitted = GaitTiming.from_array(timing)
+    base = np.asarray(problem.situations.timing0)
+    moved = [n for i, n in enumerate(TIMING_FIELDS) if timing[i] != base[i]]
+    assert set(moved) <= set(_fit.FITTED_TIMING)
+    assert fitted.stride_coefficient > 0 and fitted.duty_slope > 0
+
+
+def test_fit_arguments_are_checked(problem):
+    from tuning import _fit
+
+    with pytest.raises(ValueError, match="n_steps"):
+        _fit.fit(problem, n_steps=0)
+    with pytest.raises(ValueError, match="tau"):
+        _fit.make_problem(problem.situations, ("spider", "ant"), {}, 0.0)

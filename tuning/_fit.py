@@ -1,0 +1,195 @@
+"""Fit the scoring weights and the gait timing to the biomechanics targets (optimistix).
+
+Unknowns, positive by construction (log reparametrisation):
+
+* ``log_weights`` (19,): log of ``ScoringWeights.to_array()`` (every weight and scale);
+* ``log_timing`` (4,): log of the :data:`FITTED_TIMING` fields of ``GaitTiming``
+  (the others stay at the harvest's values).
+
+Residuals (a fixed-length vector; masked situations contribute zeros), each block
+divided by the square root of its count so that every target weighs the same
+whatever the number of situations:
+
+* stride: new swings of a moving creature, (E[step] / lambda_target(v) - 1) / tolerance,
+  lambda_target = coefficient h Fr^exponent (tuning/data/targets.toml);
+* duty factor: distance of DF(v; theta) outside the band [low, high], / (high - low),
+  for Fr < froude_max;
+* duty slope: max(0, -duty_slope - max_slope) (DF falls with speed);
+* per creature, on the mean over its situations (a population target: a detour
+  around a crate is sometimes the only way, and must not dominate the fit):
+  jerk: max(0, log(mean E[J] / maximum)); curvature: max(0, mean E[E] / maximum - 1);
+  clearance: max(0, 1 - mean E[min(clearance, c)] / c), c = minimum h;
+* prior: (y - y_0) / PRIOR_LOG_SCALE, so that parameters no target constrains stay at
+  the harvest's values (the problem is otherwise under-determined).
+
+The expectations are the soft selection of :mod:`tuning._proxies` at temperature
+``tau`` over harvested, fixed candidate sets: a fit is local, and should be
+followed by a new harvest with the fitted parameters (and another fit).
+
+:func:`fit` runs ``n_steps`` Levenberg-Marquardt steps of optimistix's solver
+(``init`` / ``step``), the steps as one ``lax.scan`` inside one ``eqx.filter_jit``.
+"""
+
+from __future__ import annotations
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+import optimistix as optx
+
+from planner._timing import GRAVITY, TIMING_FIELDS
+from tuning._proxies import Situations, duty_factor, expected_metrics
+
+FITTED_TIMING = ("stride_coefficient", "stride_exponent", "duty_at_rest", "duty_slope")
+_FITTED_INDEX = np.array([TIMING_FIELDS.index(n) for n in FITTED_TIMING])
+PRIOR_LOG_SCALE = 1.0
+"""A factor e away from the harvest's value costs as much as one target missed by its tolerance."""
+
+
+class FitProblem(eqx.Module):
+    """Situations with their creatures' targets, per situation (F,)."""
+
+    situations: Situations
+    tau: float = eqx.field(static=True)
+    stride_target_m: jax.Array
+    stride_tolerance: jax.Array
+    stride_mask: jax.Array
+    duty_low: jax.Array
+    duty_high: jax.Array
+    duty_mask: jax.Array
+    max_duty_slope: jax.Array  # () the smallest over the creatures
+    jerk_max: jax.Array
+    curvature_max: jax.Array
+    clearance_min_m: jax.Array
+    creature_one_hot: jax.Array  # (F, C) situations of each creature
+    log_weights0: jax.Array
+    log_timing0: jax.Array  # (4,)
+
+
+def make_problem(situations: Situations, creature_names, targets, tau: float) -> FitProblem:
+    """``creature_names``: the harvest's ``creatures`` (``situations.creature`` indexes it);
+    ``targets``: :func:`tuning.load_targets` output holding those creatures."""
+    if not tau > 0.0:
+        raise ValueError(f"tau: expected a temperature > 0, got {tau!r}")
+    index = np.asarray(situations.creature)
+    missing = [n for n in creature_names if n not in targets]
+    if missing:
+        raise ValueError(f"targets: no targets for {missing}")
+    per = [targets[creature_names[i]] for i in index]
+
+    def col(fn):
+        return jnp.asarray(np.array([fn(t) for t in per], dtype=np.float64))
+
+    v = np.asarray(situations.speed)
+    h = np.asarray(situations.leg_height)
+    froude = v * v / (GRAVITY * h)
+    stride = np.array([t.stride_length_m(s) for t, s in zip(per, v)])
+    duty_fr = col(lambda t: t["duty_factor"].values["froude_max"])
+    timing0 = np.asarray(situations.timing0)
+    weights0 = np.asarray(situations.weights0)
+    return FitProblem(
+        situations=situations, tau=float(tau), stride_target_m=jnp.asarray(stride),
+        stride_tolerance=col(lambda t: t["stride_length"].values["relative_tolerance"]),
+        stride_mask=jnp.asarray(np.asarray(situations.new_swing) & (v > 0.0)),
+        duty_low=col(lambda t: t["duty_factor"].values["low"]), duty_high=col(lambda t: t["duty_factor"].values["high"]),
+        duty_mask=jnp.asarray(froude) < duty_fr,
+        max_duty_slope=jnp.asarray(min(t["duty_factor_slope"].values["max_slope"] for t in per)),
+        jerk_max=col(lambda t: t["swing_jerk"].values["maximum"]),
+        curvature_max=col(lambda t: t["curvature_energy"].values["maximum"]),
+        clearance_min_m=col(lambda t: t.clearance_min_m),
+        creature_one_hot=jnp.asarray(index[:, None] == np.arange(len(creature_names))[None, :], dtype=jnp.float64),
+        log_weights0=jnp.log(jnp.asarray(weights0)), log_timing0=jnp.log(jnp.asarray(timing0[_FITTED_INDEX])))
+
+
+def timing_vector(log_timing, timing0):
+    """Full GaitTiming vector: the fitted fields from ``log_timing``, the others from ``timing0``."""
+    return jnp.asarray(timing0).at[_FITTED_INDEX].set(jnp.exp(log_timing))
+
+
+def _block(values, mask):
+    m = mask.astype(values.dtype)
+    return jnp.where(mask, values, 0.0) / jnp.sqrt(jnp.maximum(jnp.sum(m), 1.0))
+
+
+def residuals(params, problem: FitProblem):
+    """The residual vector (module docstring) at ``params = (log_weights, log_timing)``."""
+    log_weights, log_timing = params
+    s = problem.situations
+    w = jnp.exp(log_weights)
+    timing = timing_vector(log_timing, s.timing0)
+    m = expected_metrics(w, timing, s, problem.tau, clearance_cap_m=problem.clearance_min_m)
+    stride = (m["step_length_m"] / problem.stride_target_m - 1.0) / problem.stride_tolerance
+    duty = duty_factor(timing, s.speed, s.leg_height)
+    width = problem.duty_high - problem.duty_low
+    duty_out = (jax.nn.relu(problem.duty_low - duty) + jax.nn.relu(duty - problem.duty_high)) / width
+    slope = jax.nn.relu(-timing[TIMING_FIELDS.index("duty_slope")] - problem.max_duty_slope)
+    one_hot = problem.creature_one_hot
+    count = jnp.maximum(jnp.sum(one_hot, axis=0), 1.0)
+
+    def per_creature(values):  # (F,) -> (C,) mean over each creature's situations
+        return (values @ one_hot) / count
+
+    present = jnp.sum(one_hot, axis=0) > 0.0
+    # The targets are per creature; every situation of a creature carries the same numbers.
+    jerk_max = per_creature(problem.jerk_max)
+    curvature_max = per_creature(problem.curvature_max)
+    clearance_min = per_creature(problem.clearance_min_m)
+    jerk = jax.nn.relu(jnp.log(per_creature(m["jerk"]) / jnp.where(present, jerk_max, 1.0)))
+    curvature = jax.nn.relu(per_creature(m["curvature_energy"]) / jnp.where(present, curvature_max, 1.0) - 1.0)
+    clearance = jax.nn.relu(1.0 - per_creature(m["clearance_m"]) / jnp.where(present, clearance_min, 1.0))
+    return jnp.concatenate([
+        _block(jnp.where(problem.stride_mask, stride, 0.0), problem.stride_mask),
+        _block(duty_out, problem.duty_mask),
+        slope[None],
+        jnp.where(present, jerk, 0.0),
+        jnp.where(present, curvature, 0.0),
+        jnp.where(present, clearance, 0.0),
+        (log_weights - problem.log_weights0) / PRIOR_LOG_SCALE,
+        (log_timing - problem.log_timing0) / PRIOR_LOG_SCALE,
+    ])
+
+
+def loss(params, problem: FitProblem):
+    """1/2 |residuals|^2."""
+    r = residuals(params, problem)
+    return 0.5 * jnp.sum(r * r)
+
+
+def _fn(params, problem):
+    return residuals(params, problem), None
+
+
+@eqx.filter_jit
+def _run(params, problem: FitProblem, solver, n_steps: int):
+    f_struct, aux_struct = jax.eval_shape(lambda: _fn(params, problem))
+    options: dict = {}
+    tags = frozenset()
+    state = solver.init(_fn, params, problem, options, f_struct, aux_struct, tags)
+    # The solver state holds non-array leaves (e.g. the Jacobian operator's jaxpr): only its
+    # arrays go through the scan carry; the rest is the same at every step.
+    dynamic, static = eqx.partition(state, eqx.is_array)
+
+    def one_step(carry, _):
+        y, dyn = carry
+        y, st, _ = solver.step(_fn, y, problem, options, eqx.combine(dyn, static), tags)
+        return (y, eqx.filter(st, eqx.is_array)), loss(y, problem)
+
+    (params, _), history = jax.lax.scan(one_step, (params, dynamic), None, length=n_steps)
+    return params, history
+
+
+def fit(problem: FitProblem, n_steps: int = 20, solver=None):
+    """Levenberg-Marquardt from the harvest's parameters. Returns (weights (19,), timing (7,),
+    loss history (n_steps,)) as numpy arrays; the loss before the fit is ``loss(initial, problem)``."""
+    if isinstance(n_steps, bool) or not isinstance(n_steps, int) or n_steps < 1:
+        raise ValueError(f"n_steps: expected an integer >= 1, got {n_steps!r}")
+    solver = solver or optx.LevenbergMarquardt(rtol=1e-8, atol=1e-8)
+    params, history = _run(initial_params(problem), problem, solver, n_steps)
+    log_weights, log_timing = params
+    return (np.exp(np.asarray(log_weights)), np.asarray(timing_vector(log_timing, problem.situations.timing0)),
+            np.asarray(history))
+
+
+def initial_params(problem: FitProblem):
+    return (problem.log_weights0, problem.log_timing0)

@@ -1,0 +1,250 @@
+"""Differentiable proxies of the discrete couple choice.
+
+The runtime picks, per planning situation, the couple (candidate footprint k,
+slice s) of highest couple score: an argmax, piecewise constant in the weights.
+The proxy replaces it by a soft selection over the harvested couples of the
+situation::
+
+    p_ks = softmax_{valid (k, s)} (score_ks(w, theta) / tau)
+
+and reports expectations under p (step length, curvature energy, clearance,
+climb, jerk, ...) as smooth functions of the scoring weights ``w``
+(``ScoringWeights.to_array()``) and the gait-timing parameters ``theta``
+(``GaitTiming.to_array()``). As tau -> 0, p tends to the one-hot of the runtime's
+argmax (uniform over exact ties), so the expectations tend to the metrics of the
+couple the exhaustive search picks.
+
+How the timing parameters reach the choice
+------------------------------------------
+theta shapes the *preferred footprint* P the controller asks for
+(``planner._crowd.stage_plan``)::
+
+    P = predicted pelvis + rest foot + forward * v * t_stance / 2,
+    predicted pelvis = pelvis + forward * v * t_swing,
+
+with the stride frequency f(v) = max(v / lambda(v), min_frequency),
+lambda(v) = stride_coefficient * h * Fr^stride_exponent, the duty factor DF(v),
+t_stance = DF / f, and for a new swing t_swing = min(clip((1 - DF) r, 0.05, 0.95) / f, 1)
+(r = the leg's authored swing duration over the mean; a re-plan keeps the rest of
+the swing in progress, so its t_swing does not depend on theta). So P moves
+along the heading by ``v * (g(theta) - g(theta_0))``, g = t_swing + t_stance / 2,
+with theta_0 the timing of the harvest: at theta_0 the proxy sees exactly the
+runtime's P. In steady walking the realised step (lift-off to touch-down of one
+foot) is one stride v / f = lambda, symmetric about the rest foot.
+
+P enters the couple score twice: the distance feature d_k = |x_k - P| of every
+candidate (closeness goodness) and the length goodness's reference
+d_ref = max(|P - source|, cell). The expected step length therefore depends on
+theta through the probabilities only: the candidate positions x_k, the source and
+every other raw number are the harvest's, held fixed. This is a local model, valid
+while P stays well inside the harvested candidate disc (the runtime would re-centre
+the disc on the new P and plan new paths); a fit should re-harvest between
+iterations. The other legs' hips (crossings and gaps) are also held at theta_0.
+
+The gait transitions of ``planner._gait`` are not modelled: the runtime's disks
+move toward the destination disks while in stance; g uses the destination (steady
+state) durations. Only differences of g enter, so this affects the sensitivity, not
+the value at theta_0.
+"""
+
+from __future__ import annotations
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from planner._kernels_foot import FEAT_DISTANCE, N_FEATURES, N_RAW, RAW_CLEARANCE, RAW_CLIMB, RAW_CURVATURE, RAW_JERK
+from planner._kernels_foot import RAW_LENGTH
+from planner._timing import (
+    GRAVITY,
+    SWING_MAX,
+    SWING_MIN,
+    T_DUTY_AT_REST,
+    T_DUTY_MAX,
+    T_DUTY_MIN,
+    T_DUTY_SLOPE,
+    T_MIN_FREQUENCY,
+    T_STRIDE_COEFFICIENT,
+    T_STRIDE_EXPONENT,
+)
+from tuning._config import enable_x64
+from tuning._scoring import couple_score
+
+LEAST_FREQUENCY_HZ = 1e-3
+"""The crowd divides by max(f, 1e-3) (planner._crowd.stage_plan)."""
+KIND_REPLAN = 3
+
+PROXY_METRICS = ("step_length_m", "forward_offset_m", "length_m", "curvature_energy", "clearance_m", "climb_m", "jerk",
+                 "couple_score")
+"""Keys of :func:`expected_metrics`, each (F,) per situation:
+
+* ``step_length_m``: horizontal distance source -> target;
+* ``forward_offset_m``: (target - P) along the heading (how far the weights pull the
+  foot ahead of, > 0, or behind the preferred footprint);
+* ``length_m``, ``curvature_energy``, ``clearance_m``, ``climb_m``, ``jerk``: the raw
+  trajectory metrics (``planner.RAW_METRICS``); the clearance is capped at
+  ``clearance_cap_m`` (a number or (F,); +inf when nothing is blocked around a path);
+* ``couple_score``: the expected couple score.
+"""
+
+
+class Situations(eqx.Module):
+    """Harvested planning situations as float64 JAX arrays (F situations, K candidates, S slices);
+    only situations with at least one couple are kept (the softmax needs one)."""
+
+    cand_mask: jax.Array  # (F, K) bool
+    cand_xz: jax.Array  # (F, K, 2)
+    cand_features: jax.Array  # (F, K, 5)
+    couple_mask: jax.Array  # (F, K, S) bool
+    couple_raw: jax.Array  # (F, K, S, 5)
+    source: jax.Array  # (F, 3)
+    preferred: jax.Array  # (F, 2) at the harvest's timing
+    forward: jax.Array  # (F, 2)
+    speed: jax.Array  # (F,)
+    leg_height: jax.Array  # (F,)
+    relative_swing: jax.Array  # (F,)
+    new_swing: jax.Array  # (F,) bool
+    cell_size: jax.Array  # (F,)
+    creature: jax.Array  # (F,) int
+    timing0: jax.Array  # (7,) GaitTiming.to_array() of the harvest
+    weights0: jax.Array  # (19,) ScoringWeights.to_array() of the harvest
+
+    @property
+    def n_situations(self) -> int:
+        return int(self.speed.shape[0])
+
+
+def situations_from_harvest(harvest) -> Situations:
+    """Convert a :class:`planner.Harvest` (enables float64 in JAX)."""
+    enable_x64()
+    keep = np.asarray(harvest.has_couple)
+
+    def f64(a):
+        return jnp.asarray(np.asarray(a)[keep], dtype=jnp.float64)
+
+    if harvest.cand_features.shape[-1] != N_FEATURES or harvest.couple_raw.shape[-1] != N_RAW:
+        raise ValueError("harvest: features or raw metrics of the wrong width")
+    return Situations(
+        cand_mask=jnp.asarray(harvest.cand_mask[keep]), cand_xz=f64(harvest.cand_xyz[..., [0, 2]]),
+        cand_features=f64(harvest.cand_features), couple_mask=jnp.asarray(harvest.couple_mask[keep]),
+        couple_raw=f64(harvest.couple_raw), source=f64(harvest.source), preferred=f64(harvest.preferred),
+        forward=f64(harvest.forward), speed=f64(harvest.speed), leg_height=f64(harvest.leg_height),
+        relative_swing=f64(harvest.relative_swing), new_swing=jnp.asarray(harvest.kind[keep] != KIND_REPLAN),
+        cell_size=f64(harvest.cell_size), creature=jnp.asarray(harvest.creature[keep]),
+        timing0=jnp.asarray(harvest.timing, dtype=jnp.float64),
+        weights0=jnp.asarray(harvest.weights, dtype=jnp.float64))
+
+
+def stride_length(timing, speed, leg_height):
+    """lambda(v) = stride_coefficient * h * Fr^stride_exponent, 0 at v = 0 (planner._timing)."""
+    moving = speed > 0.0
+    v = jnp.where(moving, speed, 1.0)  # a safe value where v = 0: Fr^b has no derivative in b at Fr = 0
+    froude = v * v / (GRAVITY * leg_height)
+    length = timing[T_STRIDE_COEFFICIENT] * leg_height * froude ** timing[T_STRIDE_EXPONENT]
+    return jnp.where(moving, length, 0.0)
+
+
+def stride_frequency(timing, speed, leg_height):
+    """f(v) = max(v / lambda(v), min_frequency_hz) for v > 0, 0 at v = 0 (planner._timing)."""
+    moving = speed > 0.0
+    v = jnp.where(moving, speed, 1.0)
+    natural = v / stride_length(timing, v, leg_height)
+    return jnp.where(moving, jnp.maximum(natural, timing[T_MIN_FREQUENCY]), 0.0)
+
+
+def duty_factor(timing, speed, leg_height):
+    """DF(v) = clip(duty_at_rest - duty_slope * v / sqrt(g h), duty_min, duty_max) (planner._timing)."""
+    raw = timing[T_DUTY_AT_REST] - timing[T_DUTY_SLOPE] * speed / jnp.sqrt(GRAVITY * leg_height)
+    return jnp.clip(raw, timing[T_DUTY_MIN], timing[T_DUTY_MAX])
+
+
+def preferred_lead_time(timing, speed, leg_height, relative_swing, new_swing):
+    """g = t_swing + t_stance / 2 (s, steady state; module docstring): P leads by v * g.
+    A re-plan's t_swing does not depend on the timing and is left out (only differences matter)."""
+    frequency = jnp.maximum(stride_frequency(timing, speed, leg_height), LEAST_FREQUENCY_HZ)
+    duty = duty_factor(timing, speed, leg_height)
+    swing = jnp.clip((1.0 - duty) * relative_swing, SWING_MIN, SWING_MAX)
+    t_swing = jnp.where(new_swing, jnp.minimum(swing / frequency, 1.0), 0.0)
+    return t_swing + 0.5 * duty / frequency
+
+
+def preferred_footprint(timing, situations: Situations):
+    """(F, 2) the preferred footprint at timing ``theta``; = the harvest's at theta_0."""
+    s = situations
+    args = (s.speed, s.leg_height, s.relative_swing, s.new_swing)
+    shift = s.speed * (preferred_lead_time(timing, *args) - preferred_lead_time(s.timing0, *args))
+    return s.preferred + s.forward * shift[:, None]
+
+
+def _norm(dx, dz):
+    # sqrt of a floored square: equal to hypot away from 0, and differentiable at 0.
+    return jnp.sqrt(jnp.maximum(dx * dx + dz * dz, 1e-300))
+
+
+def couple_scores(weights, timing, situations: Situations):
+    """(F, K, S) couple scores at weights ``w`` and timing ``theta`` (invalid couples: -inf)."""
+    s = situations
+    pref = preferred_footprint(timing, s)
+    d = _norm(s.cand_xz[..., 0] - pref[:, None, 0], s.cand_xz[..., 1] - pref[:, None, 1])
+    features = s.cand_features.at[..., FEAT_DISTANCE].set(d)
+    d_ref = jnp.maximum(_norm(pref[:, 0] - s.source[:, 0], pref[:, 1] - s.source[:, 2]), s.cell_size)
+    score = couple_score(features[:, :, None, :], s.couple_raw, d_ref[:, None, None], weights)
+    return jnp.where(s.couple_mask, score, -jnp.inf)
+
+
+def soft_selection(scores, mask, tau):
+    """(F, K, S) probabilities softmax(score / tau) over the valid couples of each situation."""
+    flat = scores.reshape(scores.shape[0], -1)
+    valid = mask.reshape(flat.shape)
+    top = jax.lax.stop_gradient(jnp.max(jnp.where(valid, flat, -jnp.inf), axis=1, keepdims=True))
+    e = jnp.where(valid, jnp.exp((jnp.where(valid, flat, top) - top) / tau), 0.0)
+    return (e / jnp.sum(e, axis=1, keepdims=True)).reshape(scores.shape)
+
+
+def expected_metrics(weights, timing, situations: Situations, tau, clearance_cap_m=jnp.inf):
+    """Expectations under the soft selection at temperature ``tau`` (> 0): a dict of (F,)
+    arrays keyed by :data:`PROXY_METRICS`."""
+    scores = couple_scores(weights, timing, situations)
+    p = soft_selection(scores, situations.couple_mask, tau)
+    return _metrics_under(p, scores, timing, situations, clearance_cap_m)
+
+
+def hard_metrics(weights, timing, situations: Situations, clearance_cap_m=jnp.inf):
+    """The same metrics at the argmax couple of each situation (first maximum in the search's
+    order, as the exhaustive search picks): the tau -> 0 limit away from ties."""
+    s = situations
+    scores = couple_scores(weights, timing, s)
+    flat = scores.reshape(scores.shape[0], -1)
+    best = jnp.argmax(flat, axis=1)
+    one_hot = jax.nn.one_hot(best, flat.shape[1], dtype=flat.dtype).reshape(scores.shape)
+    return _metrics_under(one_hot, scores, timing, s, clearance_cap_m)
+
+
+def _metrics_under(p, scores, timing, s, clearance_cap_m):
+    """The PROXY_METRICS under the selection p (F, K, S)."""
+    pref = preferred_footprint(timing, s)
+
+    def expect(values):  # values (F, K, S); invalid couples have p = 0 and are zeroed (no inf * 0)
+        return jnp.sum(p * jnp.where(s.couple_mask, values, 0.0), axis=(1, 2))
+
+    step = _norm(s.cand_xz[..., 0] - s.source[:, None, 0], s.cand_xz[..., 1] - s.source[:, None, 2])
+    ahead = ((s.cand_xz[..., 0] - pref[:, None, 0]) * s.forward[:, None, 0]
+             + (s.cand_xz[..., 1] - pref[:, None, 1]) * s.forward[:, None, 1])
+    raw = s.couple_raw
+    clearance = raw[..., RAW_CLEARANCE]
+    finite = jnp.isfinite(clearance)
+    cap = jnp.asarray(clearance_cap_m, dtype=clearance.dtype)
+    cap = cap.reshape(cap.shape + (1,) * (clearance.ndim - cap.ndim))  # a number or (F,) per situation
+    capped = jnp.where(finite, jnp.minimum(jnp.where(finite, clearance, 0.0), cap), cap)
+    shape = raw.shape[:-1]
+    return {
+        "step_length_m": expect(jnp.broadcast_to(step[..., None], shape)),
+        "forward_offset_m": expect(jnp.broadcast_to(ahead[..., None], shape)),
+        "length_m": expect(raw[..., RAW_LENGTH]),
+        "curvature_energy": expect(raw[..., RAW_CURVATURE]),
+        "clearance_m": expect(capped),
+        "climb_m": expect(raw[..., RAW_CLIMB]),
+        "jerk": expect(raw[..., RAW_JERK]),
+        "couple_score": expect(scores),
+    }
