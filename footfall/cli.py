@@ -177,6 +177,138 @@ def simulate_cmd(
         out.print(f"recording: {record}")
 
 
+@app.command("export-usd")
+def export_usd_cmd(
+    scenario: Optional[str] = typer.Argument(None, help="Built-in scenario name or path to a scenario .toml "
+                                             "(default: mixed, or the recording's)"),
+    out: str = typer.Option(..., "--out", help="Output file: .usda (text), .usdc or .usd (binary)"),
+    frames: Optional[int] = typer.Option(None, min=1, help="Frames of 1/30 s (default 90; with --recording: "
+                                         "export the first N)"),
+    characters: Optional[int] = typer.Option(None, min=1, help="Crowd size (default 4)"),
+    creature: Optional[str] = typer.Option(None, help="Creature name or .toml (default: the scenario's, or the "
+                                           "recording's)"),
+    gait: Optional[str] = typer.Option(None, help="Gait name or .toml (default: the creature's)"),
+    seed: Optional[int] = typer.Option(None, help="Seed (default 0; same seed, same animation)"),
+    preset: Optional[str] = typer.Option(None, help="Weight preset (.json) for this creature"),
+    recording: Optional[str] = typer.Option(None, help="Export this recording (.npz from simulate --record) "
+                                            "instead of simulating"),
+) -> None:
+    """Simulate a small crowd (or take a recording) and write it as a USD scene: terrain, boxes, skinned
+    characters, foot trajectories and footprints."""
+    import tempfile
+    from pathlib import Path
+
+    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
+    from reports._recording import load_recording
+    from reports._usd import check_output_path, export_usd
+    from scenarios import default_gait_name, load_creature, load_gait, load_scenario
+
+    out_path = check_output_path(out)
+    if recording is not None:
+        given = [name for name, value in (("--characters", characters), ("--gait", gait), ("--seed", seed),
+                                          ("--preset", preset)) if value is not None]
+        if given:
+            raise InputError("argument", "--recording", f"exports a finished run: {', '.join(given)} "
+                             "cannot change it")
+        run = load_recording(recording)
+        s = load_scenario(scenario or run.scenario or "mixed")
+        c = load_creature(creature or run.creature)
+        if frames is not None:
+            run = run.head(frames)
+    else:
+        from planner._crowd import init_crowd
+        from planner._presets import load_preset
+        from planner._simulation import Recorder, simulate
+
+        frames = frames or 90
+        seed = seed or 0
+        s = load_scenario(scenario or "mixed")
+        c = load_creature(creature or s.crowd.creature)
+        g = load_gait(gait or default_gait_name(c.name), c)
+        weights = timing = None
+        if preset is not None:
+            p = load_preset(preset, c.name)
+            weights, timing = p.weights, p.timing
+        model, state = init_crowd(s, c, g, n_characters=characters or 4, seed=seed,
+                                  weights=weights, timing=timing)
+        recorder = Recorder(model, state, frames)
+        with Progress(TextColumn("simulating"), BarColumn(), TextColumn("{task.completed}/{task.total} frames"),
+                      TimeRemainingColumn(), console=_err(), transient=True) as bar:
+            task = bar.add_task("frames", total=frames)
+            summary = simulate(model, state, frames, recorder, progress=lambda k: bar.update(task, completed=k))
+        # Through the recording file, so a simulated export and the export of its recording are the same.
+        with tempfile.TemporaryDirectory(prefix="footfall-usd-") as folder:
+            path = Path(folder) / "run.npz"
+            recorder.save(path, model, summary, {"scenario": s.name, "seed": seed, "lod": "off", "gait": g.name})
+            run = load_recording(path)
+    with Progress(TextColumn("writing USD"), BarColumn(), TextColumn("{task.completed}/{task.total} parts"),
+                  console=_err(), transient=True) as bar:
+        task = bar.add_task("parts", total=2 + run.characters)
+        written = export_usd(run, s, c, out_path, progress=lambda done, total: bar.update(task, completed=done))
+    _stdout().print(f"USD: {written} ({run.characters} x {c.name} on {s.name}, {run.frames} frames)",
+                    markup=False, soft_wrap=True)
+
+
+@app.command("report")
+def report_cmd(
+    scenarios: Optional[list[str]] = typer.Argument(None, help="Scenarios to sweep (default: the preset's)"),
+    out: str = typer.Option("out/report", "--out", help="Report folder (replaced atomically)"),
+    quick: bool = typer.Option(False, "--quick", help="A small sweep (seconds; for tests)"),
+    full: bool = typer.Option(False, "--full", help="Every built-in scenario, 32 budgets, up to 100 characters"),
+    seed: int = typer.Option(0, help="Seed of every run (same seed, same metrics; timings aside)"),
+    recording: Optional[str] = typer.Option(None, help="Also render this recording (.npz from simulate --record)"),
+    json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),
+) -> None:
+    """Evaluation sweep (scenarios x LOD settings x crowd sizes): cost, quality, plots, renders, index.html."""
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+    from reports._report import build_report
+
+    if quick and full:
+        raise InputError("argument", "--quick/--full", "choose one of --quick and --full")
+    preset = "quick" if quick else "full" if full else "default"
+    err = _err()
+    warnings: list[str] = []
+    bar = Progress(TextColumn("report"), BarColumn(), TextColumn("{task.completed}/{task.total}"),
+                   TextColumn("{task.description}"), TimeElapsedColumn(), console=err, transient=True)
+    shown = []  # the bar starts with the work, so that refused input prints its one line alone
+
+    def progress(what: str, done: int, total: int) -> None:
+        if not shown:
+            bar.start()
+            shown.append(bar.add_task(what, total=total))
+        bar.update(shown[0], description=what, completed=done, total=total)
+
+    try:
+        summary = build_report(out, preset=preset, scenarios=tuple(scenarios or ()), seed=seed, recording=recording,
+                               progress=progress, warn=warnings.append)
+    finally:
+        if shown:
+            bar.stop()
+    for message in warnings:
+        err.print(f"footfall: warning: {message}", markup=False, soft_wrap=True)
+    if json_out:
+        print(json.dumps(summary))
+        return
+    table = Table(title=f"Quality vs cost ({summary['preset']}; cost = plan time / first valid couple's, "
+                        "loss = % of the exhaustive couple score; budget-cK-sS as cK-sS)")
+    for col in ("setting", "cost", "loss %", "own loss %", "ms/char", "collisions", "crossings", "front"):
+        table.add_column(col, justify="right")
+
+    def number(value, fmt):
+        return "-" if value is None else format(value, fmt)
+
+    for r in summary["rows"]:
+        table.add_row(r["setting"].removeprefix("budget-") + (" *" if r["recommended"] else ""), number(r["paired_cost_vs_first_valid"], ".3f"),
+                      number(r["paired_loss_pct"], ".3f"), f"{r['score_loss_pct']:.3f}", f"{r['ms_per_character']:.2f}",
+                      str(r["collisions"]), str(r["leg_crossings"]), "yes" if r["on_front"] else "")
+    out_console = _stdout()
+    out_console.print(table)
+    out_console.print(f"recommended budget: {summary['recommended_budget']} (*)")
+    out_console.print(f"report: {summary['index']}")
+
+
 @bench_app.command("crowd")
 def bench_crowd_cmd(
     characters: Optional[int] = typer.Option(None, min=1, help="One crowd size (default: 100 and 1000)"),
