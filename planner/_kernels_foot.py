@@ -100,24 +100,6 @@ def prepare_foot(elevation, ground, forbidden, origin_x, origin_z, cell, offsets
             hmax = 0.0
             touches_forbidden = False
             for k in range(offsets.shape[0]):
-                    r2 = r + offsets[k, 0]
-                    c2 = c + offsets[k, 1]
-                    e = elevation[r2, c2]
-                    emax = max(emax, e)
-                    hmax = max(hmax, e - ground[r2, c2])
-                    touches_forbidden |= forbidden[r2, c2] != 0
-                elev_raw[p] = elevation[r, c]
-                elev_dil[p] = emax
-                boxh_dil[p] = hmax
-                if 1 <= rr < hp - 1 and 1 <= cc < wp - 1:
-                    if forbidden[r, c]:
-                        code[p] = FORBIDDEN
-                    elif touches_forbidden:
-                        code[p] = SIZE_INCREASE
-                    else:
-                        code[p] = FREE
-                continue
-            for k in range(offsets.shape[0]):
                 r2 = r + offsets[k, 0]
                 c2 = c + offsets[k, 1]
                 if r2 < 0 or r2 >= n_rows or c2 < 0 or c2 >= n_cols:

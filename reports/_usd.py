@@ -256,12 +256,6 @@ def check_output_path(out_path: str | Path) -> Path:
     return out
 
 
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
-
-
 # ----------------------------------------------------------------------------- stage
 def _check_match(recording: Recording, scenario, creature) -> None:
     if recording.leg_names != tuple(creature.leg_names) or recording.segments != creature.n_segments:
@@ -459,8 +453,6 @@ def export_usd(recording: Recording, scenario, creature, out_path: str | Path, p
         with atomic_path(out, suffix=out.suffix) as tmp:
             if not stage.GetRootLayer().Export(str(tmp)):
                 raise OSError(f"USD could not write {out}")
-            # the temporary file is private (mkstemp); the export gets the usual permissions
-            os.chmod(tmp, 0o666 & ~_umask())
     except OSError as e:
         raise InputError(out, "out", f"cannot write: {e.strerror or e}") from None
     except Tf.ErrorException as e:
