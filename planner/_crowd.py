@@ -274,13 +274,15 @@ def _reach_xz(model: CrowdModel) -> np.ndarray:
     return np.sqrt(np.maximum(reach**2 - dy**2, (0.2 * reach) ** 2))
 
 
-def _solve_feet(model: CrowdModel, state: CrowdState, cs, ls, hips, rotation, iterations: int, restarts: int):
+def _solve_feet(model: CrowdModel, state: CrowdState, cs, ls, hips, iterations: int, restarts: int):
     """CCD for legs (cs, ls) reaching for their feet from ``hips``, warm-started from the
     current angles (the one IK call of the controller's look-ahead and IK stages)."""
     from planner._ik import solve_legs
 
     legs = model.leg_static
-    return solve_legs(hips, rotation, legs.rest_azimuths[ls], legs.segment_lengths[ls], legs.limits[ls],
+    # The body poses as (yaw, pitch, roll): rotations built from angles need no orthonormality check.
+    pose = np.column_stack([state.heading[cs], state.pitch[cs], state.roll[cs]])
+    return solve_legs(hips, pose, legs.rest_azimuths[ls], legs.segment_lengths[ls], legs.limits[ls],
                       legs.azimuth_limits[ls], state.feet[cs, ls], warm_start=state.angles[cs, ls],
                       max_iterations=iterations, restarts=restarts)
 
@@ -288,8 +290,6 @@ def _solve_feet(model: CrowdModel, state: CrowdState, cs, ls, hips, rotation, it
 def _stance_unreachable_ahead(model: CrowdModel, state: CrowdState, hips) -> np.ndarray:
     """(C, L) stance feet whose leg could not reach them ``lookahead_frames`` from now
     (IK with the hips carried forward; characters without IK are not checked)."""
-    from planner._ik import body_rotation
-
     ctl = model.controller
     out = state.cannot_follow
     out &= state.in_stance  # a foot that stepped is followed again
@@ -306,8 +306,7 @@ def _stance_unreachable_ahead(model: CrowdModel, state: CrowdState, hips) -> np.
     # The pelvis keeps rising (or sinking) as it did over the last frame; rising is what
     # stretches a stance leg, so only a rise is carried forward.
     shifted[:, 1] += ctl.lookahead_frames * np.maximum(state.pelvis_rise[cs], 0.0)
-    rotation = body_rotation(state.heading[cs], state.pitch[cs], state.roll[cs])
-    res = _solve_feet(model, state, cs, ls, shifted, rotation, iterations=4, restarts=0)
+    res = _solve_feet(model, state, cs, ls, shifted, iterations=4, restarts=0)
     out[cs, ls] = res.residual > ctl.ik_slip_margin
     return out.copy()
 
@@ -487,19 +486,16 @@ def stage_ik(model: CrowdModel, state: CrowdState, on_screen: np.ndarray) -> Non
     """CCD for every leg of the characters that need it, warm-started from the previous
     frame: stance legs with restarts (a stance foot must be followed exactly), swinging
     legs without (they only need to be close, and restarts are what costs)."""
-    from planner._ik import body_rotation
-
     state.ik_on[:] = False
     if not on_screen.any():
         return
     hips = hips_world(model, state)
-    rotation = body_rotation(state.heading, state.pitch, state.roll)
     ctl = model.controller
     for stance, restarts, iterations in ((True, ctl.ik_restarts, ctl.ik_iterations), (False, 0, ctl.ik_swing_iterations)):
         cs, ls = np.nonzero(on_screen[:, None] & (state.in_stance == stance))
         if cs.size == 0:
             continue
-        res = _solve_feet(model, state, cs, ls, hips[cs, ls], rotation[cs], iterations, restarts)
+        res = _solve_feet(model, state, cs, ls, hips[cs, ls], iterations, restarts)
         state.angles[cs, ls] = res.angles
         state.residual[cs, ls] = res.residual
         state.fk_feet[cs, ls] = res.feet
