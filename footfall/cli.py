@@ -255,7 +255,7 @@ def report_cmd(
     scenarios: Optional[list[str]] = typer.Argument(None, help="Scenarios to sweep (default: the preset's)"),
     out: str = typer.Option("out/report", "--out", help="Report folder (replaced atomically)"),
     quick: bool = typer.Option(False, "--quick", help="A small sweep (seconds; for tests)"),
-    full: bool = typer.Option(False, "--full", help="Every built-in scenario, 32 budgets, up to 100 characters"),
+    full: bool = typer.Option(False, "--full", help="Every built-in scenario, 21 budgets, up to 100 characters (long)"),
     seed: int = typer.Option(0, help="Seed of every run (same seed, same metrics; timings aside)"),
     recording: Optional[str] = typer.Option(None, help="Also render this recording (.npz from simulate --record)"),
     json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),

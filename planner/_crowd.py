@@ -43,7 +43,7 @@ from planner._kernels_controller import (
 from planner._kernels_maps import build_local_maps
 from planner._lod import FULL_SEARCH, LodConfig, frame_crowd, lod_budgets, visibility
 from planner._maps import WorldRaster
-from planner._params import PlannerConfig
+from planner._params import PlannerConfig, SearchBudget
 from planner._weights import ScoringWeights
 
 DT = 1.0 / 30.0
@@ -106,6 +106,7 @@ class CrowdModel:
     rest_body: np.ndarray  # (L, 2) forward, lateral (scaled by feet_spacing)
     reach: np.ndarray  # (L,) leg reach, m
     leg_static: object  # IK statics (planner._ik)
+    fixed_budget: SearchBudget | None = None  # with lod_mode 'off': every search gets this budget (evaluation sweeps)
 
     @property
     def n_legs(self) -> int:
@@ -362,7 +363,7 @@ def character_budgets(model: CrowdModel, state: CrowdState):
     """(couples_after_first (C,), slice_size (C,), on_screen (C,)) from the LOD mode and camera."""
     n = state.pelvis.shape[0]
     if model.lod_mode == "off":
-        c, s, _ = FULL_SEARCH.kernel_args()
+        c, s, _ = (model.fixed_budget or FULL_SEARCH).kernel_args()
         return np.full(n, c, np.int64), np.full(n, s), np.ones(n, np.bool_)
     fov = float(model.camera.fov)
     if model.lod_mode == "on":
@@ -558,8 +559,13 @@ def planner_config_for(creature) -> PlannerConfig:
 def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, seed: int = 0,
                weights: ScoringWeights | None = None, timing=None, lod_mode: str = "off",
                config: PlannerConfig | None = None, controller: ControllerConfig | None = None,
-               lod: LodConfig | None = None, raster: WorldRaster | None = None) -> tuple[CrowdModel, CrowdState]:
-    """Build the static model and the initial state of a crowd (validated before any frame)."""
+               lod: LodConfig | None = None, raster: WorldRaster | None = None,
+               budget: SearchBudget | None = None) -> tuple[CrowdModel, CrowdState]:
+    """Build the static model and the initial state of a crowd (validated before any frame).
+
+    ``budget``: one search budget for every character instead of the paper's full search
+    (only with ``lod_mode='off'``: the LOD modes set their own budgets).
+    """
     from footfall._errors import InputError
     from planner._gait import init_gaits
     from planner._ik import legs_of, rest_pose_angles
@@ -567,6 +573,8 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
 
     if lod_mode not in ("on", "zoomed", "off"):
         raise InputError("argument", "--lod", f"expected on, zoomed or off, got {lod_mode!r}")
+    if budget is not None and lod_mode != "off":
+        raise ValueError(f"budget: a fixed search budget needs lod_mode 'off', got {lod_mode!r}")
     config = config or planner_config_for(creature)
     controller = controller or ControllerConfig()
     weights = weights or ScoringWeights()
@@ -599,7 +607,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         lod_mode=lod_mode, raster=raster, camera=scenario.camera, dt=DT, feet_spacing=spacing,
         hips_body=np.asarray(creature.hips, dtype=np.float64),
         rest_body=spacing * np.asarray(creature.rest_feet, dtype=np.float64),
-        reach=np.asarray(creature.leg_reach, dtype=np.float64), leg_static=legs_of(creature))
+        reach=np.asarray(creature.leg_reach, dtype=np.float64), leg_static=legs_of(creature), fixed_budget=budget)
     rng = np.random.default_rng(seed)
     positions = spawn_positions(scenario, creature, n)
     if scenario.crowd.heading_mode == "random":

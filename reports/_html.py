@@ -1,0 +1,130 @@
+"""The report's ``index.html``: one self-contained page, images and data linked relatively."""
+
+from __future__ import annotations
+
+import html
+import math
+
+from reports._pareto import COLUMNS, LOSS_TOLERANCE_PCT, PAIRED_COLUMNS
+
+STYLE = """
+body { font-family: system-ui, sans-serif; margin: 2em auto; max-width: 1200px; color: #222; }
+.scroll { overflow-x: auto; }
+table { border-collapse: collapse; font-size: 12px; margin: 1em 0; }
+td:first-child { white-space: nowrap; }
+th, td { border: 1px solid #ccc; padding: 3px 6px; text-align: right; }
+th { background: #f0f0f0; } td:first-child, th:first-child { text-align: left; }
+tr.front td { background: #eef5ff; } tr.recommended td { background: #ffe9a8; font-weight: bold; }
+.box { border: 2px solid #c44e52; padding: 0.6em 1em; background: #fff6f6; }
+.warning { border: 2px solid #d08000; padding: 0.6em 1em; background: #fff4e0; }
+img { max-width: 100%; border: 1px solid #ddd; margin: 0.4em 0; }
+.pair { display: grid; grid-template-columns: 1fr 1fr; gap: 1em; }
+"""
+
+
+def _fmt(value) -> str:
+    if value is None:
+        return "none"
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, float):
+        if not math.isfinite(value):
+            return str(value)
+        if value != 0 and (abs(value) < 1e-3 or abs(value) >= 1e5):
+            return f"{value:.3g}"
+        return f"{value:.4g}"
+    return html.escape(str(value))
+
+
+def _table(rows: list[dict], columns: list[tuple[str, str]], row_class=None) -> str:
+    head = "".join(f'<th title="{html.escape(unit)}">{html.escape(name)}</th>' for name, unit in columns)
+    body = []
+    for r in rows:
+        cls = row_class(r) if row_class else ""
+        cells = "".join(f"<td>{_fmt(r.get(name))}</td>" for name, _ in columns)
+        body.append(f'<tr class="{cls}">{cells}</tr>')
+    return f"<div class='scroll'><table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table></div>"
+
+
+def _img(src: str, alt: str) -> str:
+    return f'<img src="{html.escape(src)}" alt="{html.escape(alt)}">'
+
+
+TASK_COLUMNS = [(n, "") for n in ("scenario", "seed", "setting", "characters", "frames", "ms_per_frame",
+                                  "ms_per_character", "plan_us_per_foot", "planner_calls", "cells_per_plan",
+                                  "situations", "deficit_mean", "collisions", "forbidden_footprints", "leg_crossings",
+                                  "strides", "stride_error_median", "curvature_energy_mean", "ik_residual_p95_m")]
+
+
+def write_index(path, *, analysis: dict, results: list[dict], meta: dict, scenes: list[dict],
+                recording: dict | None) -> None:
+    """Write ``index.html``. ``scenes``: per scenario, the relative image paths and render status."""
+    rows = analysis["rows"]
+    rec = next((r for r in rows if r["recommended"]), None)
+    parts = [f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>footfall report</title>"
+             f"<style>{STYLE}</style></head><body>",
+             "<h1>footfall evaluation report</h1>",
+             f"<p>footfall {html.escape(meta['footfall'])}, preset <b>{html.escape(meta['preset'])}</b>, seed "
+             f"{meta['seed']}; scenarios {html.escape(', '.join(meta['scenarios']))}; crowd sizes "
+             f"{', '.join(map(str, meta['sizes']))}; {meta['frames']} measured frames after {meta['warmup']} "
+             f"warm-up frames; {len(results)} runs in {meta['wall_seconds']:.0f} s. "
+             "Data: <a href='results.csv'>results.csv</a> (one row per run), <a href='summary.csv'>summary.csv</a> "
+             "(one row per setting), <a href='paired.csv'>paired.csv</a> (the budgets on the same requests), "
+             "<a href='results.json'>results.json</a> (everything).</p>"]
+    if rec is not None:
+        parts.append(
+            f"<div class='box'><b>Recommended budget: {html.escape(rec['setting'])}</b> "
+            f"({_fmt(rec['couples_after_first'])} couples after the first valid one, slices "
+            f"{_fmt(rec['slice_size_m'])} m): {rec['paired_cost_vs_first_valid']:.3f} x the first valid couple's "
+            f"planning time ({rec['paired_us_per_foot']:.1f} µs per foot plan), "
+            f"{rec['paired_loss_pct']:.3f} % of the exhaustive couple score lost (every budget planning the same "
+            "requests).<br>Rule: among the fixed budgets, the cheapest (planning time relative to the first valid "
+            "couple's) whose score loss is at most "
+            f"{analysis['tolerance_pct']} percentage points above the smallest loss of any budget; it is always on the "
+            "Pareto front.</div>")
+    parts.append("<h2>Quality vs cost</h2>"
+                 "<p>Cost: the planning time per foot relative to the first valid couple's on the same requests "
+                 "(timed alternately on one core, so the load of other programs cancels out) and in µs, the crowd's "
+                 "median ms per frame and per character, planner calls, wavefront cells expanded. Each setting's own "
+                 "runs give its row; for the fixed budgets the paired_* columns come from every budget planning the "
+                 "same requests (those of a no-LOD crowd): the Pareto front and the recommendation use these. "
+                 "Frame timings move with the load of the machine. Quality: the couple-score deficit against the exhaustive search "
+                 "(planner.EXHAUSTIVE: no couple limit, 5 cm slices, exact stop) on the same situations, "
+                 "collisions, forbidden footprints, leg crossings, stride length error against "
+                 "λ = 2.3 h Fr<sup>0.3</sup>, curvature energy E = l ∫κ² ds of the swing paths (horizontal, "
+                 "u in [0.05, 0.95]) and the IK residual. Blue rows: on the budgets' Pareto front; yellow: recommended. "
+                 "Hover a column name for its unit.</p>")
+    columns = [(n, u) for n, _, u in COLUMNS]
+    parts.append(_table(rows, columns[:4] + list(PAIRED_COLUMNS) + columns[4:] + [("on_front", "")],
+                        lambda r: "recommended" if r["recommended"] else ("front" if r["on_front"] else "")))
+    parts.append(_img("pareto.png", "quality vs cost Pareto front"))
+    parts.append("<h2>Stride length vs speed</h2><p>Every pair of consecutive touch-downs of a foot in the "
+                 "measured frames: the distance between the two footprints against the pelvis speed over that time; "
+                 "the black line is the biomechanics target (Alexander 1976), the orange one the median realised stride "
+                 "per speed bin. Footprints are centres of the planner's grid cells, so single strides come in "
+                 "multiples of the cell size (7 cm for the spider); at low speeds the gait keeps a minimum stride "
+                 "frequency, so strides are shorter than the target there by design.</p>")
+    parts.append(_img("stride.png", "stride length vs speed"))
+    for s in scenes:
+        parts.append(f"<h2>Scenario {html.escape(s['scenario'])}</h2>")
+        parts.append(f"<p>{html.escape(s['caption'])}</p><div class='pair'>")
+        for src, alt in s["plots"]:
+            parts.append(f"<div>{_img(src, alt)}</div>")
+        parts.append("</div>")
+        if s["renders"]:
+            parts.append("<div class='pair'>" + "".join(f"<div>{_img(src, alt)}</div>" for src, alt in s["renders"])
+                         + "</div>")
+        if s.get("render_error"):
+            parts.append(f"<p class='warning'>3D rendering failed: {html.escape(s['render_error'])}</p>")
+    if recording is not None:
+        parts.append(f"<h2>Recording {html.escape(recording['name'])}</h2><p>{html.escape(recording['caption'])}</p>")
+        if recording["renders"]:
+            parts.append("<div class='pair'>" + "".join(f"<div>{_img(src, alt)}</div>"
+                                                         for src, alt in recording["renders"]) + "</div>")
+        if recording.get("render_error"):
+            parts.append(f"<p class='warning'>3D rendering failed: {html.escape(recording['render_error'])}</p>")
+    parts.append("<h2>Every run</h2><details><summary>one row per (scenario, seed, setting, crowd size)</summary>")
+    parts.append(_table(results, TASK_COLUMNS))
+    parts.append(f"</details><p>Score-loss tolerance of the rule: {LOSS_TOLERANCE_PCT} points.</p></body></html>")
+    with open(path, "w", encoding="utf-8") as fh:
+        fh.write("\n".join(parts))
