@@ -258,6 +258,8 @@ def report_cmd(
     full: bool = typer.Option(False, "--full", help="Every built-in scenario, 21 budgets, up to 100 characters (long)"),
     seed: int = typer.Option(0, help="Seed of every run (same seed, same metrics; timings aside)"),
     recording: Optional[str] = typer.Option(None, help="Also render this recording (.npz from simulate --record)"),
+    cluster: Optional[str] = typer.Option(None, help="Dask scheduler address (tcp://host:8786) to run the sweep on"),
+    workers: Optional[int] = typer.Option(None, help="Local worker processes (default: one per core; 1: in-process)"),
     json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),
 ) -> None:
     """Evaluation sweep (scenarios x LOD settings x crowd sizes): cost, quality, plots, renders, index.html."""
@@ -282,7 +284,7 @@ def report_cmd(
 
     try:
         summary = build_report(out, preset=preset, scenarios=tuple(scenarios or ()), seed=seed, recording=recording,
-                               progress=progress, warn=warnings.append)
+                               progress=progress, warn=warnings.append, workers=workers, cluster=cluster)
     finally:
         if shown:
             bar.stop()
@@ -307,6 +309,43 @@ def report_cmd(
     out_console.print(table)
     out_console.print(f"recommended budget: {summary['recommended_budget']} (*)")
     out_console.print(f"report: {summary['index']}")
+
+
+@app.command("tune")
+def tune_cmd(
+    creature: str = typer.Option(..., "--creature", help="Built-in creature to tune"),
+    out: Optional[str] = typer.Option(None, "--out", help="Preset file (.json; default out/presets/CREATURE.json); "
+                                      "the checkpoint is written beside it"),
+    resume: bool = typer.Option(False, "--resume", help="Continue a killed run from its checkpoint"),
+    rounds: int = typer.Option(2, "--rounds", help="Outer rounds at most (harvest, fit, exact loss)"),
+    seed: int = typer.Option(0, "--seed", help="Seed of the harvests and runs (same seed, same preset)"),
+    json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),
+) -> None:
+    """Tune a creature's scoring weights and gait timing against the biomechanics targets and write a preset."""
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+    from tuning._tune import TuneConfig, check_creature, check_output, tune
+
+    check_creature(creature)
+    path = check_output(out or f"out/presets/{creature}.json")
+    config = TuneConfig(creature, rounds=rounds, seed=seed)
+    bar = Progress(TextColumn("tune"), BarColumn(), TextColumn("{task.description}"), TimeElapsedColumn(),
+                   console=_err(), transient=True)
+    with bar:
+        task = bar.add_task("starting", total=config.rounds + 2)
+        result = tune(config, path, resume=resume,
+                      progress=lambda what, done, total: bar.update(task, description=what, completed=done,
+                                                                    total=total))
+    summary = dict(result.summary, wall_s=result.wall_s, preset=str(path))
+    if json_out:
+        print(json.dumps(summary))
+        return
+    table = Table(title=f"footfall tune {creature}: default -> tuned")
+    table.add_column("metric")
+    table.add_column("value", justify="right")
+    for key, value in summary.items():
+        table.add_row(key, f"{value:.4g}" if isinstance(value, float) else str(value))
+    _stdout().print(table)
 
 
 @bench_app.command("crowd")

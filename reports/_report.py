@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from footfall._errors import InputError
+from reports._distribute import check_workers, run_tasks
 from reports import _html, _pareto, _plots, _sweep
 
 REPORT_FORMAT = "footfall-report"
@@ -151,11 +152,15 @@ def task_columns(results: list[dict]) -> list[str]:
 
 
 def build_report(out, *, preset: str = "default", scenarios: tuple[str, ...] | None = None, seed: int = 0,
-                 recording: str | None = None, progress=None, warn=None) -> dict:
+                 recording: str | None = None, progress=None, warn=None, workers: int | None = None,
+                 cluster: str | None = None) -> dict:
     """Run the sweep and write the report folder ``out``; returns the summary (JSON-ready).
 
     ``progress(description, completed, total)`` is called as work advances;
     ``warn(message)`` for problems that do not stop the report (a failed render).
+    ``workers`` / ``cluster``: where the sweep's tasks run (:mod:`reports._distribute`:
+    one local worker process per core by default, ``workers=1`` in this process, or the
+    workers of a Dask scheduler); the metrics do not depend on it.
     """
     from footfall import __version__
 
@@ -168,6 +173,7 @@ def build_report(out, *, preset: str = "default", scenarios: tuple[str, ...] | N
         options = dataclasses.replace(options, scenarios=tuple(scenarios))
     options = dataclasses.replace(options, seeds=(int(seed),))
     _sweep.check_scenarios(options.scenarios)
+    check_workers(workers, cluster)
     rec = load_recording(recording) if recording is not None else None
     if rec is not None:
         _sweep.check_scenarios([rec["header"]["scenario"]])
@@ -183,11 +189,11 @@ def build_report(out, *, preset: str = "default", scenarios: tuple[str, ...] | N
     try:
         with tempfile.TemporaryDirectory(prefix="footfall-report-") as work_dir:
             work = Path(work_dir)
-            results = []
-            for task in tasks:
-                progress(f"{task['scenario']} x{task['characters']} {task['setting']}", done, total)
-                results.append(_sweep.run_task(task))
-                done += 1
+            progress("sweep", done, total)
+            results = run_tasks(_sweep.run_task, tasks, workers=workers, cluster=cluster,
+                                progress=lambda task, k: progress(
+                                    f"{task['scenario']} x{task['characters']} {task['setting']}", done + k, total))
+            done += len(tasks)
             analysis = _pareto.analyse(results)
             _plots.pareto_plot(analysis, tmp / "pareto.png")
             runs = [r for r in results if r["kind"] != "paired"]

@@ -113,6 +113,22 @@ PRESETS = {
 }
 
 
+TIMING_KEYS = frozenset({"ms_per_frame", "ms_per_character", "plan_ms_per_frame", "ik_ms_per_frame",
+                         "plan_us_per_foot", "wall_seconds", "plan_cost_vs_first_valid", "us_per_foot",
+                         "cost_vs_first_valid"})
+"""Result fields measured with a clock: they move with the load of the machine; every other
+field of a task's result depends only on the task (same task, same numbers, on any worker)."""
+
+
+def without_timings(result):
+    """A task's result with the :data:`TIMING_KEYS` fields left out, nested rows included."""
+    if isinstance(result, dict):
+        return {k: without_timings(v) for k, v in result.items() if k not in TIMING_KEYS}
+    if isinstance(result, list):
+        return [without_timings(v) for v in result]
+    return result
+
+
 def build_tasks(options: SweepOptions) -> list[dict]:
     """One task per (scenario, seed, setting, crowd size), then one paired cost task per
     (scenario, seed, crowd size) over every fixed budget; in a fixed order."""

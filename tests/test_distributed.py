@@ -1,0 +1,65 @@
+"""Sweeps on Dask workers (issue 6): same results as in-process, and a worker killed
+mid-sweep costs only its tasks. The cluster listens on loopback only."""
+
+from __future__ import annotations
+
+import os
+import signal
+import time
+
+import pytest
+
+from footfall._errors import InputError
+from reports._distribute import check_workers, run_tasks
+from reports._sweep import PRESETS, build_tasks, run_task, without_timings
+
+
+@pytest.fixture(scope="module")
+def quick_tasks():
+    tasks = build_tasks(PRESETS["quick"])
+    assert len(tasks) >= 4  # enough to have tasks in flight on both workers when one dies
+    return tasks
+
+
+@pytest.fixture(scope="module")
+def in_process(quick_tasks):
+    return run_tasks(run_task, quick_tasks, workers=1)
+
+
+def test_a_worker_killed_mid_sweep_costs_only_its_tasks(quick_tasks, in_process):
+    from distributed import Client, LocalCluster
+
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                      dashboard_address=None) as cluster, Client(cluster) as client:
+        killed = []
+
+        def kill_a_busy_worker(task, done):
+            if killed:
+                return
+            # Wait (bounded) until some worker is running a task, then kill its process.
+            for _ in range(200):
+                busy = [w for w, keys in client.processing().items() if keys]
+                if busy:
+                    pid = client.run(os.getpid, workers=[busy[0]])[busy[0]]
+                    os.kill(pid, signal.SIGKILL)
+                    killed.append(busy[0])
+                    return
+                time.sleep(0.05)
+
+        results = run_tasks(run_task, quick_tasks, cluster=cluster.scheduler_address, progress=kill_a_busy_worker)
+    assert killed, "no worker was busy: the sweep did not run on the cluster"
+    assert len(results) == len(quick_tasks)
+    assert [without_timings(r) for r in results] == [without_timings(r) for r in in_process]
+
+
+def test_local_worker_processes_give_the_in_process_results(quick_tasks, in_process):
+    results = run_tasks(run_task, quick_tasks[:3], workers=2)
+    assert [without_timings(r) for r in results] == [without_timings(r) for r in in_process[:3]]
+
+
+@pytest.mark.parametrize("workers, cluster, field", [(0, None, "--workers"), (2, "tcp://127.0.0.1:1", "--workers"),
+                                                     (None, "127.0.0.1:8786", "--cluster")])
+def test_bad_worker_options_are_refused(workers, cluster, field):
+    with pytest.raises(InputError) as e:
+        check_workers(workers, cluster)
+    assert e.value.field == field
