@@ -73,6 +73,7 @@ class ControllerConfig:
     step_height_factor: float = 0.3  # x standing height
     reach_margin: float = 0.95  # stance feet beyond this fraction of the reach step
     threat_margin: float = 0.04  # m, a moving box this close to a stance foot makes it step
+    threat_horizon: float = 0.3  # s, ... or this close to it where the box will be this much later
     bob_factor: float = 0.03  # x standing height, pelvis bobbing amplitude
     lookahead_frames: int = 4  # stance feet the IK cannot follow this many frames ahead step now
     lookahead_every: int = 2  # frames between two look-ahead checks of a character (< lookahead_frames)
@@ -328,6 +329,14 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips) -> 
         stance_threatened(state.in_stance, state.feet, 0.5 * model.creature.foot_length,
                           0.5 * model.creature.foot_width, state.foot_yaws, ctl.threat_margin, centres, sizes, yaws,
                           forbidden, moving, threatened)
+        # A box on its way: where it will be ``threat_horizon`` from now. A foot needs a frame to
+        # plan and a few to lift clear, and a crate at 0.4 m/s covers the 4 cm margin in 3 frames.
+        later_centres, _, later_yaws, _, _ = _boxes_now(model, state.t + ctl.threat_horizon)
+        threatened_later = np.zeros_like(threatened)
+        stance_threatened(state.in_stance, state.feet, 0.5 * model.creature.foot_length,
+                          0.5 * model.creature.foot_width, state.foot_yaws, ctl.threat_margin, later_centres, sizes,
+                          later_yaws, forbidden, moving, threatened_later)
+        threatened |= threatened_later
         swings_invalidated(state.in_stance, state.swing_t, state.swing_T, state.trajectories,
                            0.5 * model.creature.foot_length, 0.5 * model.creature.foot_width, state.foot_yaws,
                            centres, sizes, yaws, forbidden, moving, 2.0 * model.rest_radius + 1.0, invalid)
