@@ -79,6 +79,15 @@ SCORE_COUPLE, SCORE_FOOTPRINT, SCORE_TRAJECTORY = range(3)
 
 
 @nb.njit(cache=True)
+def path_workspace(hp, wp):
+    """Work buffers of the path construction for an ROI of hp x wp padded cells:
+    (rows, cols) of a supercover walk, the dense 2D samples and their cells, the 3D polyline."""
+    cap = 4 * (hp + wp) + 8
+    return (np.empty(cap, dtype=np.int64), np.empty(cap, dtype=np.int64), np.empty((MAX_DENSE, 3), dtype=np.float64),
+            np.empty(MAX_DENSE, dtype=np.int64), np.empty((MAX_DENSE, 3), dtype=np.float64))
+
+
+@nb.njit(cache=True)
 def foot_setup(elevation, ground, forbidden, origin_x, origin_z, offsets, source, preferred, hip, reach_xz, other_legs,
                feet_block_radius, w, cfg, slice_size):
     """ROI maps, potential footprints, slices and d_ref of one foot (shared by the search and the
@@ -162,12 +171,7 @@ def plan_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, 
     ready = np.zeros(n_slices, dtype=np.uint8)
     one = np.empty(1, dtype=np.int64)
     stop = np.empty(max(n_cand, 1), dtype=np.int64)
-    cap = 4 * (hp + wp) + 8
-    rows = np.empty(cap, dtype=np.int64)
-    cols = np.empty(cap, dtype=np.int64)
-    dense = np.empty((MAX_DENSE, 3), dtype=np.float64)
-    dense_p = np.empty(MAX_DENSE, dtype=np.int64)
-    poly = np.empty((MAX_DENSE, 3), dtype=np.float64)
+    rows, cols, dense, dense_p, poly = path_workspace(hp, wp)
     best_poly = np.empty((MAX_DENSE, 3), dtype=np.float64)
     jerk_work = np.empty((JERK_SAMPLES, 3), dtype=np.float64)
     terms = np.empty(N_TERMS, dtype=np.float64)
@@ -332,12 +336,7 @@ def harvest_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offset
     dist = np.empty(n, dtype=np.float64)
     parent = np.empty(n, dtype=np.int64)
     stop = np.empty(max(n_cand, 1), dtype=np.int64)
-    cap = 4 * (hp + wp) + 8
-    rows = np.empty(cap, dtype=np.int64)
-    cols = np.empty(cap, dtype=np.int64)
-    dense = np.empty((MAX_DENSE, 3), dtype=np.float64)
-    dense_p = np.empty(MAX_DENSE, dtype=np.int64)
-    poly = np.empty((MAX_DENSE, 3), dtype=np.float64)
+    rows, cols, dense, dense_p, poly = path_workspace(hp, wp)
     jerk_work = np.empty((JERK_SAMPLES, 3), dtype=np.float64)
     terms = np.empty(N_TERMS, dtype=np.float64)
     for s in range(n_slices):
