@@ -9,9 +9,16 @@
   (``tuning/data/targets.toml``), per creature, normalised by its leg length.
 * :mod:`tuning._fit`: Levenberg-Marquardt (optimistix) on the target residuals,
   log-parametrised weights and timing, the steps as one ``lax.scan``.
+* :mod:`tuning._exact`: the exact loss -- the real crowd over a speed sweep, realised
+  stride length vs 2.3 h Fr^0.3, duty factor, curvature energy, clearance, collisions.
+* :mod:`tuning._tune`: the outer loop (harvest -> fit -> exact loss, checkpoint after
+  every round, resume), held-out evaluation and the preset (``footfall tune``). Shipped
+  presets: ``tuning/data/presets/<creature>.json`` (:data:`PRESETS_DIR`).
 
 tuning/ computes in float64: its entry points call :func:`enable_x64`.
 """
+
+from pathlib import Path
 
 from tuning._config import enable_x64
 from tuning._fit import FITTED_TIMING, FitProblem, fit, loss, make_problem, residuals
@@ -40,7 +47,11 @@ from tuning._scoring import (
     weighted_mean,
 )
 
+PRESETS_DIR = Path(__file__).resolve().parent / "data" / "presets"
+"""The shipped, tuned presets (``footfall simulate --preset tuning/data/presets/spider.json``)."""
+
 __all__ = [
+    "PRESETS_DIR",
     "FITTED_TIMING",
     "FitProblem",
     "fit",

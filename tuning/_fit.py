@@ -17,7 +17,13 @@ whatever the number of situations:
 * duty slope: max(0, -duty_slope - max_slope) (DF falls with speed);
 * per creature, on the mean over its situations (a population target: a detour
   around a crate is sometimes the only way, and must not dominate the fit):
-  jerk: max(0, log(mean E[J] / maximum)); curvature: max(0, mean E[E] / maximum - 1);
+  jerk: sqrt(jerk_weight) max(0, log(mean E[J] / maximum)), **jerk_weight = 0 by default**:
+  the runtime's jerk metric (``planner._kernels_foot.geometric_jerk``) is dominated by
+  finite-difference sampling noise (median about 1.2e5 against the Flash & Hogan target
+  of order 1e3), so no weights can meet that target and the block would only pull every
+  weight toward the jerk term; :mod:`tuning._tune` instead refuses a candidate whose
+  exact median jerk rises above the default weights' (a "do not increase" guard);
+  curvature: max(0, mean E[E] / maximum - 1);
   clearance: max(0, 1 - mean E[min(clearance, c)] / c), c = minimum h;
 * prior: (y - y_0) / PRIOR_LOG_SCALE, so that parameters no target constrains stay at
   the harvest's values (the problem is otherwise under-determined).
@@ -65,13 +71,17 @@ class FitProblem(eqx.Module):
     creature_one_hot: jax.Array  # (F, C) situations of each creature
     log_weights0: jax.Array
     log_timing0: jax.Array  # (4,)
+    jerk_weight: jax.Array  # () weight of the jerk block (0 by default: module docstring)
 
 
-def make_problem(situations: Situations, creature_names, targets, tau: float) -> FitProblem:
+def make_problem(situations: Situations, creature_names, targets, tau: float, jerk_weight: float = 0.0) -> FitProblem:
     """``creature_names``: the harvest's ``creatures`` (``situations.creature`` indexes it);
-    ``targets``: :func:`tuning.load_targets` output holding those creatures."""
+    ``targets``: :func:`tuning.load_targets` output holding those creatures; ``jerk_weight``:
+    weight of the jerk block (0: off, the default; module docstring)."""
     if not tau > 0.0:
         raise ValueError(f"tau: expected a temperature > 0, got {tau!r}")
+    if isinstance(jerk_weight, bool) or not isinstance(jerk_weight, (int, float)) or not jerk_weight >= 0.0:
+        raise ValueError(f"jerk_weight: expected a number >= 0, got {jerk_weight!r}")
     index = np.asarray(situations.creature)
     missing = [n for n in creature_names if n not in targets]
     if missing:
@@ -99,7 +109,8 @@ def make_problem(situations: Situations, creature_names, targets, tau: float) ->
         curvature_max=col(lambda t: t["curvature_energy"].values["maximum"]),
         clearance_min_m=col(lambda t: t.clearance_min_m),
         creature_one_hot=jnp.asarray(index[:, None] == np.arange(len(creature_names))[None, :], dtype=jnp.float64),
-        log_weights0=jnp.log(jnp.asarray(weights0)), log_timing0=jnp.log(jnp.asarray(timing0[_FITTED_INDEX])))
+        log_weights0=jnp.log(jnp.asarray(weights0)), log_timing0=jnp.log(jnp.asarray(timing0[_FITTED_INDEX])),
+        jerk_weight=jnp.asarray(float(jerk_weight), dtype=jnp.float64))
 
 
 def timing_vector(log_timing, timing0):
@@ -142,7 +153,7 @@ def residuals(params, problem: FitProblem):
         _block(jnp.where(problem.stride_mask, stride, 0.0), problem.stride_mask),
         _block(duty_out, problem.duty_mask),
         slope[None],
-        jnp.where(present, jerk, 0.0),
+        jnp.sqrt(problem.jerk_weight) * jnp.where(present, jerk, 0.0),
         jnp.where(present, curvature, 0.0),
         jnp.where(present, clearance, 0.0),
         (log_weights - problem.log_weights0) / PRIOR_LOG_SCALE,
