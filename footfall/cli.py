@@ -136,29 +136,24 @@ def simulate_cmd(
     """Simulate a crowd walking through a scenario and report what happened."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
-    from planner._crowd import init_crowd
+    from footfall._runs import recorded_run, recording_meta
     from planner._presets import load_preset
-    from planner._simulation import Recorder, simulate
     from scenarios import default_gait_name, load_creature, load_gait, load_scenario
 
     s = load_scenario(scenario)
     c = load_creature(creature or s.crowd.creature)
     g = load_gait(gait or default_gait_name(c.name), c)
-    weights = timing = None
-    if preset is not None:
-        p = load_preset(preset, c.name)
-        weights, timing = p.weights, p.timing
+    p = load_preset(preset, c.name) if preset is not None else None
     if record is not None and not record.endswith(".npz"):
         raise InputError("argument", "--record", f"expected a .npz path, got {record!r}")
-    model, state = init_crowd(s, c, g, n_characters=characters, seed=seed, weights=weights, timing=timing,
-                              lod_mode=lod)
-    recorder = Recorder(model, state, frames) if record else None
     with Progress(TextColumn("simulating"), BarColumn(), TextColumn("{task.completed}/{task.total} frames"),
                   TimeRemainingColumn(), console=_err(), transient=True, disable=json_out) as bar:
         task = bar.add_task("frames", total=frames)
-        summary = simulate(model, state, frames, recorder, progress=lambda k: bar.update(task, completed=k))
+        model, summary, recorder = recorded_run(s, c, g, frames=frames, characters=characters, seed=seed, preset=p,
+                                                lod=lod, record=record is not None,
+                                                progress=lambda k: bar.update(task, completed=k))
     if record:
-        recorder.save(record, model, summary, {"scenario": s.name, "seed": seed, "lod": lod, "gait": g.name})
+        recorder.save(record, model, summary, recording_meta(s, seed, lod, g))
     if json_out:
         print(json.dumps(summary.to_json()))
         return
@@ -175,6 +170,50 @@ def simulate_cmd(
     out.print(table)
     if record:
         out.print(f"recording: {record}")
+
+
+@app.command("run")
+def run_cmd(
+    scenario: str = typer.Argument("mixed", help="Built-in scenario name or path to a scenario .toml"),
+    out: str = typer.Option("out", "--out", help="Output folder"),
+    seed: int = typer.Option(0, help="Seed of every step (same seed, same results; timings aside)"),
+    quick: bool = typer.Option(False, "--quick", help="Short runs and a quick sweep (seconds; for tests)"),
+    workers: Optional[int] = typer.Option(None, help="Local worker processes of the report's sweep (default: one "
+                                          "per core; 1: in-process)"),
+    json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),
+) -> None:
+    """The main job: simulate the scenario's crowd, tune its creature, report, and export a USD scene."""
+    from rich.progress import Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
+
+    from footfall._mainjob import STEPS, run_main_job
+
+    with Progress(SpinnerColumn(), TextColumn("{task.description}"), TimeElapsedColumn(), console=_err(),
+                  transient=True, disable=json_out) as bar:
+        task = bar.add_task("starting", total=len(STEPS))
+
+        def progress(step: str, message: str) -> None:
+            bar.update(task, completed=STEPS.index(step), description=f"[{STEPS.index(step) + 1}/{len(STEPS)}] "
+                       f"{step}: {message}")
+
+        summary = run_main_job(scenario, out, seed=seed, quick=quick, workers=workers, progress=progress)
+    if json_out:
+        print(json.dumps(summary))
+        return
+    o, sec = summary["outputs"], summary["seconds"]
+    tune = summary["tune"]
+    lines = [
+        f"footfall run: {summary['scenario']} ({summary['creature']}), {sec['total']:.0f} s",
+        f"  simulate  {sec['simulate']:6.1f} s  {o['recording']}  ({summary['simulate']['steps']} steps, "
+        f"{summary['simulate']['collisions']} collisions)",
+        f"  tune      {sec['tune']:6.1f} s  {o['preset']}  (exact loss {tune.get('exact_loss_default', float('nan')):.3g}"
+        f" -> {tune.get('exact_loss_tuned', float('nan')):.3g})",
+        f"  report    {sec['report']:6.1f} s  {o['report']}  (recommended budget: "
+        f"{summary['report']['recommended_budget']})",
+        f"  export    {sec['export']:6.1f} s  {o['usd']}",
+        f"  summary   {o['summary']}",
+        f"Open {o['report']} in a browser to look at the results.",
+    ]
+    _stdout().print("\n".join(lines), markup=False, soft_wrap=True)
 
 
 @app.command("export-usd")
@@ -217,30 +256,24 @@ def export_usd_cmd(
         if frames is not None:
             run = run.head(frames)
     else:
-        from planner._crowd import init_crowd
+        from footfall._runs import recorded_run, recording_meta
         from planner._presets import load_preset
-        from planner._simulation import Recorder, simulate
 
         frames = frames or 90
         seed = seed or 0
         s = load_scenario(scenario or "mixed")
         c = load_creature(creature or s.crowd.creature)
         g = load_gait(gait or default_gait_name(c.name), c)
-        weights = timing = None
-        if preset is not None:
-            p = load_preset(preset, c.name)
-            weights, timing = p.weights, p.timing
-        model, state = init_crowd(s, c, g, n_characters=characters or 4, seed=seed,
-                                  weights=weights, timing=timing)
-        recorder = Recorder(model, state, frames)
+        p = load_preset(preset, c.name) if preset is not None else None
         with Progress(TextColumn("simulating"), BarColumn(), TextColumn("{task.completed}/{task.total} frames"),
                       TimeRemainingColumn(), console=_err(), transient=True) as bar:
             task = bar.add_task("frames", total=frames)
-            summary = simulate(model, state, frames, recorder, progress=lambda k: bar.update(task, completed=k))
+            model, summary, recorder = recorded_run(s, c, g, frames=frames, characters=characters or 4, seed=seed,
+                                                    preset=p, progress=lambda k: bar.update(task, completed=k))
         # Through the recording file, so a simulated export and the export of its recording are the same.
         with tempfile.TemporaryDirectory(prefix="footfall-usd-") as folder:
             path = Path(folder) / "run.npz"
-            recorder.save(path, model, summary, {"scenario": s.name, "seed": seed, "lod": "off", "gait": g.name})
+            recorder.save(path, model, summary, recording_meta(s, seed, "off", g))
             run = load_recording(path)
     with Progress(TextColumn("writing USD"), BarColumn(), TextColumn("{task.completed}/{task.total} parts"),
                   console=_err(), transient=True) as bar:

@@ -1,0 +1,27 @@
+"""One recorded crowd run: the piece ``simulate``, ``export-usd`` and the main job share."""
+
+from __future__ import annotations
+
+
+def recorded_run(scenario, creature, gait, *, frames: int, characters: int | None = None, seed: int = 0,
+                 preset=None, lod: str = "off", record: bool = True, progress=None):
+    """Simulate ``frames`` frames of the scenario's crowd; returns (model, summary, recorder or None).
+
+    ``preset``: a loaded :class:`planner.Preset` (its weights and timing), or None for the defaults.
+    ``progress(k)`` is called after frame k.
+    """
+    from planner._crowd import init_crowd
+    from planner._simulation import Recorder, simulate
+
+    weights = preset.weights if preset is not None else None
+    timing = preset.timing if preset is not None else None
+    model, state = init_crowd(scenario, creature, gait, n_characters=characters, seed=seed, weights=weights,
+                              timing=timing, lod_mode=lod)
+    recorder = Recorder(model, state, frames) if record else None
+    summary = simulate(model, state, frames, recorder, progress=progress)
+    return model, summary, recorder
+
+
+def recording_meta(scenario, seed: int, lod: str, gait) -> dict:
+    """What a recording's header says about its run, beside the recorder's own fields."""
+    return {"scenario": scenario.name, "seed": int(seed), "lod": lod, "gait": gait.name}
