@@ -63,6 +63,16 @@ def run_tasks(function: Callable[[dict], dict], tasks: Sequence[dict], *, worker
     return _run_dask(function, tasks, workers or default_workers(), cluster, progress)
 
 
+def _single_threaded(function, task: dict) -> dict:
+    """Run a task on a worker with the planner's kernels on one thread: the workers already
+    share out the cores, and numba's parallel loops crawl when two processes each spread
+    over every core (results are the same: the kernels are bit-identical serial and parallel)."""
+    import numba
+
+    numba.set_num_threads(1)
+    return function(task)
+
+
 def _run_dask(function, tasks, workers, cluster, progress) -> list[dict]:
     from distributed import Client, LocalCluster, as_completed
 
@@ -79,7 +89,8 @@ def _run_dask(function, tasks, workers, cluster, progress) -> list[dict]:
             except (OSError, TimeoutError) as e:
                 raise InputError("argument", "--cluster", f"cannot reach the scheduler {cluster}: {e}") from None
         with client:
-            futures = client.map(function, [dict(t) for t in tasks], pure=False, retries=TASK_RETRIES)
+            futures = client.map(_single_threaded, [function] * len(tasks), [dict(t) for t in tasks], pure=False,
+                                 retries=TASK_RETRIES)
             index = {f.key: k for k, f in enumerate(futures)}
             results: list = [None] * len(tasks)
             done = 0
