@@ -447,7 +447,9 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
         step_height=np.full(f, model.controller.step_height_factor * model.creature.standing_height),
         legs=np.ascontiguousarray(legs), legs_start=np.arange(f + 1, dtype=np.int64) * 2 * (n_legs - 1),
         block_radius=np.full(f, math.hypot(model.creature.foot_length, model.creature.foot_width)),
-        couples_after_first=couples[cs], slice_size=slices[cs], early=np.ones(f, np.bool_))
+        couples_after_first=couples[cs], slice_size=slices[cs],
+        # the paper's early termination (§5.2) always, unless a fixed budget says otherwise
+        early=np.full(f, model.fixed_budget is None or model.fixed_budget.paper_early_stop, np.bool_))
     out = plan_batch(batch, model.weights, model.config, parallel=True)
     ok = out.valid
     vc, vl = cs[ok], ls[ok]
