@@ -9,7 +9,8 @@ that raised on a worker that was going down.
 
 * ``workers == 1`` and no ``cluster``: a plain loop in this process (no Dask at all);
 * no ``cluster``: a ``LocalCluster`` of ``workers`` processes (default: one per core),
-  one thread each (the planner's kernels use the process's cores themselves), on loopback;
+  one thread each, on loopback; on every worker the planner's numba kernels run on one
+  thread too (the workers share out the cores);
 * ``cluster="tcp://host:8786"``: the workers of an existing scheduler (``dask scheduler``
   on one machine, ``dask worker tcp://host:8786`` on each of the others).
 
