@@ -104,6 +104,22 @@ class Recorder:
                 np.savez_compressed(fh, header=np.array(json.dumps(header)), events=events, **self.arrays)
 
 
+def realised_strides(feet, in_stance, pelvis, dt: float):
+    """(speed (n,), stride (n,)) of every pair of consecutive touch-downs of the same foot, from
+    per-frame arrays (frames, C, L, 3) feet, (frames, C, L) in_stance and (frames, C, 3) pelvis:
+    stride = horizontal distance between the two footprints (one cycle of that foot), speed =
+    the pelvis's horizontal displacement over the same frames / their duration (m/s)."""
+    down = in_stance[1:] & ~in_stance[:-1]  # touched down at frame k + 1
+    frames, chars, legs = np.nonzero(down)
+    order = np.lexsort((frames, legs, chars))
+    frames, chars, legs = frames[order] + 1, chars[order], legs[order]
+    same = np.flatnonzero((chars[1:] == chars[:-1]) & (legs[1:] == legs[:-1]))
+    k0, k1, c, leg = frames[same], frames[same + 1], chars[same], legs[same]
+    stride = np.hypot(feet[k1, c, leg, 0] - feet[k0, c, leg, 0], feet[k1, c, leg, 2] - feet[k0, c, leg, 2])
+    moved = np.hypot(pelvis[k1, c, 0] - pelvis[k0, c, 0], pelvis[k1, c, 2] - pelvis[k0, c, 2])
+    return (moved / ((k1 - k0) * dt)).astype(np.float64), stride.astype(np.float64)
+
+
 def simulate(model: CrowdModel, state: CrowdState, frames: int, recorder: Recorder | None = None,
              progress=None) -> SimulationSummary:
     """Run ``frames`` steps; never raises on a foot that cannot step (it holds)."""

@@ -40,6 +40,7 @@ import numpy as np
 
 from footfall._errors import InputError
 from planner._batch import plan_batch
+from planner._simulation import realised_strides
 
 TIMING_REPEATS = 3  # rounds of the paired benchmark (the best per batch and budget counts)
 OWN_TIMING_EVERY = 4  # a run's own requests: every n-th planning call is timed once (cheap, noisier)
@@ -284,27 +285,6 @@ def target_stride_length(speed, hip_height: float):
 
     v = np.asarray(speed, dtype=np.float64)
     return 2.3 * hip_height * np.power(v * v / (GRAVITY * hip_height), 0.3)
-
-
-def realised_strides(feet, in_stance, pelvis, dt: float):
-    """(speed (n,), stride (n,)) of every pair of consecutive touch-downs of the same foot.
-
-    stride = horizontal distance between the two footprints (one cycle of that foot),
-    speed = the pelvis's horizontal displacement over the same time / that time.
-    """
-    down = in_stance[1:] & ~in_stance[:-1]  # (F-1, C, L): touched down at frame k + 1
-    speeds, strides = [], []
-    frames, chars, legs = np.nonzero(down)
-    order = np.lexsort((frames, legs, chars))
-    frames, chars, legs = frames[order] + 1, chars[order], legs[order]
-    same = (chars[1:] == chars[:-1]) & (legs[1:] == legs[:-1])
-    for j in np.flatnonzero(same):
-        k0, k1, c, leg = frames[j], frames[j + 1], chars[j], legs[j]
-        stride = float(np.hypot(*(feet[k1, c, leg, [0, 2]] - feet[k0, c, leg, [0, 2]])))
-        moved = float(np.hypot(*(pelvis[k1, c, [0, 2]] - pelvis[k0, c, [0, 2]])))
-        speeds.append(moved / ((k1 - k0) * dt))
-        strides.append(stride)
-    return np.asarray(speeds), np.asarray(strides)
 
 
 def _load_inputs(scenario_name: str):

@@ -58,6 +58,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from planner._kernels_foot import RAW_CLEARANCE, RAW_CURVATURE, RAW_JERK
+from planner._simulation import realised_strides
 
 STRIDE_MIN_CELLS = 1.5
 """Lowest speed of the sweep: where the target stride is this many planner cells. Footprints are
@@ -132,21 +133,6 @@ def speeds_for(setup: ExactSetup) -> np.ndarray:
 
     h = hip_height(load_creature(setup.creature))
     return np.sqrt(np.asarray(setup.froude, dtype=np.float64) * GRAVITY * h)
-
-
-def realised_strides(feet, in_stance, pelvis, dt: float):
-    """(speed (n,), stride (n,)) of every pair of consecutive touch-downs of the same foot:
-    stride = horizontal distance between the two footprints, speed = the pelvis's horizontal
-    displacement over the same frames / their duration."""
-    down = in_stance[1:] & ~in_stance[:-1]  # touched down at frame k + 1
-    frames, chars, legs = np.nonzero(down)
-    order = np.lexsort((frames, legs, chars))
-    frames, chars, legs = frames[order] + 1, chars[order], legs[order]
-    same = np.flatnonzero((chars[1:] == chars[:-1]) & (legs[1:] == legs[:-1]))
-    k0, k1, c, leg = frames[same], frames[same + 1], chars[same], legs[same]
-    stride = np.hypot(feet[k1, c, leg, 0] - feet[k0, c, leg, 0], feet[k1, c, leg, 2] - feet[k0, c, leg, 2])
-    moved = np.hypot(pelvis[k1, c, 0] - pelvis[k0, c, 0], pelvis[k1, c, 2] - pelvis[k0, c, 2])
-    return moved / ((k1 - k0) * dt), stride
 
 
 def run_one(creature_name: str, scenario_name: str, seed: int, speed: float, weights, timing, frames: int,
