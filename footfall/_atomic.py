@@ -15,6 +15,23 @@ def _umask() -> int:
     return mask
 
 
+def unwritable_reason(folder: str | Path) -> str | None:
+    """Why outputs cannot be written into ``folder`` (created if missing), or None.
+
+    Its nearest existing ancestor (itself if it exists) must be a folder this process may
+    write in; checked before any work, so a refused output costs nothing.
+    """
+    folder = Path(folder).absolute()
+    existing = folder
+    while not existing.exists() and existing != existing.parent:
+        existing = existing.parent
+    if not existing.is_dir():
+        return f"cannot create {folder}: {existing} is a file, not a folder"
+    if not os.access(existing, os.W_OK | os.X_OK):
+        return f"cannot write in {existing}: permission denied"
+    return None
+
+
 @contextmanager
 def atomic_path(target: str | Path, suffix: str = "") -> Iterator[Path]:
     """Yield a temporary path next to ``target``; rename it over ``target`` on success.

@@ -20,7 +20,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from footfall._atomic import write_text_atomic
+from footfall._atomic import unwritable_reason, write_text_atomic
 from footfall._errors import InputError
 
 STEPS = ("simulate", "tune", "report", "export")
@@ -33,16 +33,13 @@ def _writable_folder(out: Path) -> Path:
     out = Path(out).absolute()
     if out.exists() and not out.is_dir():
         raise InputError(out, "--out", "exists and is not a folder")
+    reason = unwritable_reason(out)
+    if reason:
+        raise InputError(out, "--out", reason)
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as e:
         raise InputError(out, "--out", f"cannot create the folder: {e.strerror or e}") from None
-    probe = out / ".footfall-write-test"
-    try:
-        probe.write_text("")
-        probe.unlink()
-    except OSError as e:
-        raise InputError(out, "--out", f"cannot write in the folder: {e.strerror or e}") from None
     return out
 
 

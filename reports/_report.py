@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from footfall._atomic import unwritable_reason
 from footfall._errors import InputError
 from reports._distribute import check_workers, run_tasks
 from reports import _html, _pareto, _plots, _sweep
@@ -44,17 +45,13 @@ def _writable_out(out: Path) -> None:
         if not ok:
             raise InputError("argument", "--out", f"{out} is a folder that is not a footfall report; "
                              "choose a new or empty folder")
-    for ancestor in out.parents:
-        if ancestor.exists():
-            if not ancestor.is_dir():
-                raise InputError("argument", "--out", f"cannot create {out}: {ancestor} is a file, not a folder")
-            break
+    reason = unwritable_reason(out.parent)
+    if reason:
+        raise InputError("argument", "--out", reason)
     try:
         out.parent.mkdir(parents=True, exist_ok=True)
     except OSError as e:
         raise InputError("argument", "--out", f"cannot create {out.parent}: {e.strerror or e}") from None
-    if not os.access(out.parent, os.W_OK | os.X_OK):
-        raise InputError("argument", "--out", f"cannot write in {out.parent}: permission denied")
 
 
 def _make_temp(out: Path) -> Path:

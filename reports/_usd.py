@@ -36,13 +36,12 @@ with the pelvis at the origin.
 from __future__ import annotations
 
 import math
-import os
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from footfall._atomic import atomic_path
+from footfall._atomic import atomic_path, unwritable_reason
 from footfall._errors import InputError
 from planner._ik import legs_of, rest_pose_angles
 from reports._recording import Recording
@@ -246,13 +245,9 @@ def check_output_path(out_path: str | Path) -> Path:
         raise InputError(out, "out", f"expected a {', '.join(USD_SUFFIXES)} file name")
     if out.is_dir():
         raise InputError(out, "out", "is a directory")
-    ancestor = out.parent
-    while not ancestor.exists() and ancestor != ancestor.parent:
-        ancestor = ancestor.parent
-    if not ancestor.is_dir():
-        raise InputError(out, "out", f"cannot create the folder: {ancestor} is not a directory")
-    if not os.access(ancestor, os.W_OK | os.X_OK):
-        raise InputError(out, "out", f"cannot write in {ancestor}: permission denied")
+    reason = unwritable_reason(out.parent)
+    if reason:
+        raise InputError(out, "out", reason)
     return out
 
 

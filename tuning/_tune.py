@@ -150,18 +150,19 @@ def check_creature(name: str) -> str:
 def check_output(path: str | Path) -> Path:
     """Refuse an output that cannot be written, before any work."""
     import os
-    import tempfile
+
+    from footfall._atomic import unwritable_reason
 
     path = Path(path)
     if path.suffix != ".json":
         raise InputError("argument", "--out", f"expected a .json path, got {str(path)!r}")
     if path.is_dir():
         raise InputError("argument", "--out", f"{path} is a directory")
+    reason = unwritable_reason(path.parent)
+    if reason:
+        raise InputError("argument", "--out", reason)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        fd, probe = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-        os.close(fd)
-        os.unlink(probe)
     except OSError as e:
         raise InputError("argument", "--out", f"cannot write to {path.parent}: {e.strerror or e}") from None
     if path.exists() and not os.access(path, os.W_OK):
