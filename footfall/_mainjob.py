@@ -24,6 +24,9 @@ from footfall._atomic import unwritable_reason, write_text_atomic
 from footfall._errors import InputError
 
 STEPS = ("simulate", "tune", "report", "export")
+QUICK_TUNE = {"rounds": 1, "exact_scenarios": ("flat", "hills@seed=1"), "exact_seeds": (0,), "holdout_seeds": (101,),
+              "holdout_characters": 1}
+"""``--quick``: one round on fewer exact runs (a smoke test of the pipeline, not a preset to ship)."""
 SIMULATE_FRAMES = 300
 EXPORT_FRAMES = 90
 EXPORT_CHARACTERS = 4
@@ -79,9 +82,9 @@ def run_main_job(scenario_name: str, out_dir, *, seed: int = 0, quick: bool = Fa
 
     t0 = time.perf_counter()
     progress("tune", f"{creature.name}: harvest, fit, exact loss")
-    config = TuneConfig(creature.name, seed=seed, **({"rounds": 1} if quick else {}))
+    config = TuneConfig(creature.name, seed=seed, **(QUICK_TUNE if quick else {}))
     preset_path = out / "preset.json"
-    tuned = tune(config, preset_path, progress=lambda what, done, total: progress("tune", what))
+    tuned = tune(config, preset_path, progress=lambda what, done, total: progress("tune", what), workers=workers)
     summary["tune"] = dict(tuned.summary, wall_s=tuned.wall_s)
     summary["seconds"]["tune"] = time.perf_counter() - t0
 

@@ -22,6 +22,26 @@ def recorded_run(scenario, creature, gait, *, frames: int, characters: int | Non
     return model, summary, recorder
 
 
+def load_named_preset(value: str, creature: str):
+    """``--preset``: a preset file, or the name of a shipped preset (``tuning/data/presets/<name>.json``:
+    ``--preset spider``). Refused with one line naming the file and the field if it is for another
+    creature, of another schema version, or malformed (``planner._presets.load_preset``)."""
+    from pathlib import Path
+
+    from footfall._errors import InputError
+    from planner._presets import load_preset
+    from tuning import PRESETS_DIR  # no JAX: tuning's __init__ re-exports lazily
+
+    path = Path(value)
+    if path.suffix != ".json" and len(path.parts) == 1 and not path.exists():
+        shipped = sorted(p.stem for p in PRESETS_DIR.glob("*.json"))
+        if value not in shipped:
+            raise InputError("argument", "--preset",
+                             f"{value!r} is neither a .json file nor a shipped preset ({', '.join(shipped)})")
+        path = PRESETS_DIR / f"{value}.json"
+    return load_preset(path, creature)
+
+
 def recording_meta(scenario, seed: int, lod: str, gait) -> dict:
     """What a recording's header says about its run, beside the recorder's own fields."""
     return {"scenario": scenario.name, "seed": int(seed), "lod": lod, "gait": gait.name}

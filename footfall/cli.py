@@ -129,21 +129,20 @@ def simulate_cmd(
     gait: Optional[str] = typer.Option(None, help="Gait name or .toml (default: the creature's)"),
     lod: str = typer.Option("off", help="Level of detail: on, zoomed or off"),
     seed: int = typer.Option(0, help="Seed (same seed, same recording)"),
-    preset: Optional[str] = typer.Option(None, help="Weight preset (.json) for this creature"),
+    preset: Optional[str] = typer.Option(None, help="Weight preset for this creature: a .json file or a shipped one by name (spider, ant, ...)"),
     record: Optional[str] = typer.Option(None, help="Save the recording (.npz)"),
     json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),
 ) -> None:
     """Simulate a crowd walking through a scenario and report what happened."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
-    from footfall._runs import recorded_run, recording_meta
-    from planner._presets import load_preset
+    from footfall._runs import load_named_preset, recorded_run, recording_meta
     from scenarios import default_gait_name, load_creature, load_gait, load_scenario
 
     s = load_scenario(scenario)
     c = load_creature(creature or s.crowd.creature)
     g = load_gait(gait or default_gait_name(c.name), c)
-    p = load_preset(preset, c.name) if preset is not None else None
+    p = load_named_preset(preset, c.name) if preset is not None else None
     if record is not None and not record.endswith(".npz"):
         raise InputError("argument", "--record", f"expected a .npz path, got {record!r}")
     with Progress(TextColumn("simulating"), BarColumn(), TextColumn("{task.completed}/{task.total} frames"),
@@ -228,7 +227,7 @@ def export_usd_cmd(
                                            "recording's)"),
     gait: Optional[str] = typer.Option(None, help="Gait name or .toml (default: the creature's)"),
     seed: Optional[int] = typer.Option(None, help="Seed (default 0; same seed, same animation)"),
-    preset: Optional[str] = typer.Option(None, help="Weight preset (.json) for this creature"),
+    preset: Optional[str] = typer.Option(None, help="Weight preset for this creature: a .json file or a shipped one by name (spider, ant, ...)"),
     recording: Optional[str] = typer.Option(None, help="Export this recording (.npz from simulate --record) "
                                             "instead of simulating"),
 ) -> None:
@@ -256,15 +255,14 @@ def export_usd_cmd(
         if frames is not None:
             run = run.head(frames)
     else:
-        from footfall._runs import recorded_run, recording_meta
-        from planner._presets import load_preset
+        from footfall._runs import load_named_preset, recorded_run, recording_meta
 
         frames = frames or 90
         seed = seed or 0
         s = load_scenario(scenario or "mixed")
         c = load_creature(creature or s.crowd.creature)
         g = load_gait(gait or default_gait_name(c.name), c)
-        p = load_preset(preset, c.name) if preset is not None else None
+        p = load_named_preset(preset, c.name) if preset is not None else None
         with Progress(TextColumn("simulating"), BarColumn(), TextColumn("{task.completed}/{task.total} frames"),
                       TimeRemainingColumn(), console=_err(), transient=True) as bar:
             task = bar.add_task("frames", total=frames)
@@ -352,13 +350,18 @@ def tune_cmd(
     resume: bool = typer.Option(False, "--resume", help="Continue a killed run from its checkpoint"),
     rounds: int = typer.Option(2, "--rounds", help="Outer rounds at most (harvest, fit, exact loss)"),
     seed: int = typer.Option(0, "--seed", help="Seed of the harvests and runs (same seed, same preset)"),
+    cluster: Optional[str] = typer.Option(None, help="Dask scheduler address (tcp://host:8786) to run the harvests "
+                                          "and exact runs on"),
+    workers: Optional[int] = typer.Option(None, help="Local worker processes (default: one per core; 1: in-process)"),
     json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),
 ) -> None:
     """Tune a creature's scoring weights and gait timing against the biomechanics targets and write a preset."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
+    from footfall._distribute import check_workers
     from tuning._tune import TuneConfig, check_creature, check_output, tune
 
+    check_workers(workers, cluster)
     check_creature(creature)
     path = check_output(out or f"out/presets/{creature}.json")
     config = TuneConfig(creature, rounds=rounds, seed=seed)
@@ -366,7 +369,7 @@ def tune_cmd(
                    console=_err(), transient=True)
     with bar:
         task = bar.add_task("starting", total=config.rounds + 2)
-        result = tune(config, path, resume=resume,
+        result = tune(config, path, resume=resume, workers=workers, cluster=cluster,
                       progress=lambda what, done, total: bar.update(task, description=what, completed=done,
                                                                     total=total))
     summary = dict(result.summary, wall_s=result.wall_s, preset=str(path))
@@ -406,6 +409,29 @@ def bench_crowd_cmd(
                           f"{row['ik_ms']:.2f}", f"{row['fps']:.0f}")
         out.print(table)
     out.print("paper (2012, 100 spiders): LOD 26 ms, LOD zoomed 28 ms, no LOD 45 ms per frame")
+
+
+@bench_app.command("tuning")
+def bench_tuning_cmd(
+    creature: str = typer.Option("spider", help="Built-in creature to tune"),
+    max_evals: int = typer.Option(150, "--max-evals", min=1, help="CMA-ES budget of exact-planner evaluations"),
+    rounds: int = typer.Option(2, min=1, help="Outer rounds of the optimistix tune at most"),
+    seed: int = typer.Option(0, min=0, help="Seed of the tune and of CMA-ES"),
+    json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),
+) -> None:
+    """Optimistix on the JAX proxies vs CMA-ES on the exact planner: wall time and exact evaluations
+    to reach the same exact loss."""
+    from benchmarks.tuning_bench import run, table
+    from tuning._tune import check_creature
+
+    check_creature(creature)
+    with _err().status("benchmarking the tuning...") as status:
+        result = run(creature, seed=seed, max_evals=max_evals, rounds=rounds,
+                     progress=lambda m: status.update(f"benchmarking: {m}"))
+    if json_out:
+        print(json.dumps(result))
+        return
+    _stdout().print(table(result))
 
 
 @bench_app.command("planner")

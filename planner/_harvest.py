@@ -12,7 +12,9 @@ own goodness and scoring functions, so the runtime's scores are stored alongside
 * :func:`harvest_situations`: short seeded crowd runs (``init_crowd`` / ``step``)
   over built-in scenarios and creatures; every planning request of every frame
   becomes a situation. Struct-of-arrays, padded to the largest candidate and
-  slice counts, with masks. Deterministic for a seed.
+  slice counts, with masks. Deterministic for a seed. Each (creature, scenario, seed)
+  run is an independent task (:func:`harvest_chunk`), so a caller may hand them to
+  worker processes (``map_tasks``); planner/ itself never imports Dask.
 """
 
 from __future__ import annotations
@@ -217,12 +219,17 @@ def _pack(rows: list[dict], creatures, scenarios, weights: np.ndarray, timing: n
 
 def harvest_situations(scenarios=("mixed",), creatures=("spider",), *, seeds=(0,), frames: int = 30,
                        n_characters: int = 2, weights: ScoringWeights | None = None, timing=None,
-                       max_situations: int | None = None) -> Harvest:
+                       max_situations: int | None = None, map_tasks=None) -> Harvest:
     """Run ``frames`` frames of a seeded crowd (LOD off: the paper's full search) per scenario,
     creature and seed, and harvest every planning request (module docstring).
 
     Creatures use their default gait. Stops once ``max_situations`` situations are
     collected (whole frames: the last frame's requests are all kept).
+
+    The runs are independent chunks, one per (creature, scenario, seed) (:func:`harvest_tasks`,
+    :func:`harvest_chunk`). ``map_tasks(function, tasks) -> list`` (results in task order, e.g.
+    from ``footfall._distribute.task_runner``) runs them, on workers or not; None runs them here,
+    one after the other. The result is the same, bit for bit, either way.
     """
     from planner._timing import GaitTiming
 
@@ -237,43 +244,98 @@ def harvest_situations(scenarios=("mixed",), creatures=("spider",), *, seeds=(0,
     if max_situations is not None and (isinstance(max_situations, bool) or not isinstance(max_situations, int)
                                        or max_situations < 1):
         raise ValueError(f"max_situations: expected None or an integer >= 1, got {max_situations!r}")
+    if map_tasks is not None and not callable(map_tasks):
+        raise ValueError(f"map_tasks: expected None or a callable, got {type(map_tasks).__name__}")
     weights = weights or ScoringWeights()
     timing = timing or GaitTiming()
+    tasks = harvest_tasks(scenarios, creatures, seeds, frames, n_characters, weights, timing, max_situations)
+    if map_tasks is None:
+        # Lazily: once the cap is reached the remaining chunks are never run (as the sequential loop did).
+        chunks = (harvest_chunk(task) for task in tasks)
+    else:
+        # Every chunk runs (in parallel); those past the cap are dropped by the merge.
+        chunks = map_tasks(harvest_chunk, tasks)
+    rows = _merge_chunks(chunks, max_situations)
+    return _pack(rows, creatures, scenarios, weights.to_array(), timing.to_array())
+
+
+def harvest_tasks(scenarios, creatures, seeds, frames: int, n_characters: int, weights: ScoringWeights, timing,
+                  max_situations: int | None) -> list[dict]:
+    """One plain-dict task per (creature, scenario, seed), in the order the situations are packed.
+
+    A task carries every input of its run (names, their indices in the harvest, parameters as
+    lists of floats), so it gives the same rows wherever it runs. Its cap is the global one: a
+    chunk never contributes more than ``max_situations`` rows (plus the rest of its last frame).
+    """
+    w = [float(x) for x in weights.to_array()]
+    t = [float(x) for x in timing.to_array()]
+    return [{"creature": str(creature_name), "creature_index": ci, "scenario": str(scenario_name),
+             "scenario_index": si, "seed": int(seed), "frames": int(frames), "n_characters": int(n_characters),
+             "weights": w, "timing": t, "max_situations": max_situations}
+            for ci, creature_name in enumerate(creatures)
+            for si, scenario_name in enumerate(scenarios)
+            for seed in seeds]
+
+
+def harvest_chunk(task: dict) -> dict:
+    """Run one task of :func:`harvest_tasks`: ``{"rows": [...], "frame_ends": [...]}``, the situations
+    of its crowd run in order and the row count after each harvested frame (where a global cap may cut).
+
+    Rows hold numpy arrays and :class:`FootHarvest` records: picklable, for a worker to send back.
+    """
+    from planner._crowd import init_crowd, planner_config_for, step
+    from planner._maps import WorldRaster
+    from planner._timing import GaitTiming
+    from scenarios import default_gait_name, load_creature, load_gait, load_scenario
+
+    weights = ScoringWeights.from_array(task["weights"])
+    timing = GaitTiming.from_array(task["timing"])
+    cap = task["max_situations"]
     # A few characters plan a few feet per frame: fanning each small kernel call out over
     # the cores costs more than it saves (x20 on a busy 2-core machine), and the parallel
-    # and serial kernels give identical results (tests/test_planner_properties.py).
+    # and serial kernels give identical results (tests/test_planner_properties.py). Set here,
+    # not by the caller, so a chunk run by any map_tasks gets it.
     threads = numba.get_num_threads()
     numba.set_num_threads(1)
     try:
-        return _run(scenarios, creatures, seeds, frames, n_characters, weights, timing, max_situations)
-    finally:
-        numba.set_num_threads(threads)
-
-
-def _run(scenarios, creatures, seeds, frames, n_characters, weights, timing, max_situations) -> Harvest:
-    from planner._crowd import init_crowd, planner_config_for, step
-    from planner._maps import WorldRaster
-    from scenarios import default_gait_name, load_creature, load_gait, load_scenario
-
-    rows: list[dict] = []
-    for ci, creature_name in enumerate(creatures):
-        creature = load_creature(creature_name)
+        creature = load_creature(task["creature"])
         gait = load_gait(default_gait_name(creature.name), creature)
         cell = planner_config_for(creature).cell_size
-        for si, scenario_name in enumerate(scenarios):
-            scenario = load_scenario(scenario_name)
-            raster = WorldRaster.build(scenario.terrain, scenario.obstacles, cell)
-            for seed in seeds:
-                model, state = init_crowd(scenario, creature, gait, n_characters=n_characters, seed=int(seed),
-                                          weights=weights, timing=timing, lod_mode="off", raster=raster)
-                meta = {"creature": ci, "scenario": si, "seed": int(seed)}
-                for _ in range(frames):
-                    step(model, state)
-                    if state.last_plans is None:
-                        continue
-                    cs, ls, kinds, out = state.last_plans
-                    _harvest_batch(state.last_batch, model.weights, model.config, out, cs, ls, kinds, state, model,
-                                   meta, rows)
-                    if max_situations is not None and len(rows) >= max_situations:
-                        return _pack(rows, creatures, scenarios, weights.to_array(), timing.to_array())
-    return _pack(rows, creatures, scenarios, weights.to_array(), timing.to_array())
+        scenario = load_scenario(task["scenario"])
+        # Built per chunk (deterministic), not shared between the seeds of a scenario: a chunk
+        # depends on nothing but its task.
+        raster = WorldRaster.build(scenario.terrain, scenario.obstacles, cell)
+        model, state = init_crowd(scenario, creature, gait, n_characters=task["n_characters"], seed=task["seed"],
+                                  weights=weights, timing=timing, lod_mode="off", raster=raster)
+        meta = {"creature": task["creature_index"], "scenario": task["scenario_index"], "seed": task["seed"]}
+        rows: list[dict] = []
+        frame_ends: list[int] = []
+        for _ in range(task["frames"]):
+            step(model, state)
+            if state.last_plans is None:
+                continue
+            cs, ls, kinds, out = state.last_plans
+            _harvest_batch(state.last_batch, model.weights, model.config, out, cs, ls, kinds, state, model, meta,
+                           rows)
+            frame_ends.append(len(rows))
+            # The global count is at least this chunk's, so the global cap never cuts later than here.
+            if cap is not None and len(rows) >= cap:
+                break
+    finally:
+        numba.set_num_threads(threads)
+    return {"rows": rows, "frame_ends": frame_ends}
+
+
+def _merge_chunks(chunks, max_situations: int | None) -> list[dict]:
+    """Concatenate the chunks' rows in task order, cut as the sequential loop cut: at the end of the
+    first frame at which the running total reaches ``max_situations`` (whole frames; later chunks
+    add nothing, and are not even pulled from a lazy ``chunks``)."""
+    rows: list[dict] = []
+    for chunk in chunks:
+        if max_situations is not None:
+            for end in chunk["frame_ends"]:
+                if len(rows) + end >= max_situations:
+                    rows.extend(chunk["rows"][:end])
+                    return rows
+        rows.extend(chunk["rows"])
+    return rows

@@ -90,7 +90,8 @@ def stride_plot(results: list[dict], path) -> None:
             ax.plot(centres, medians, c="#dd8452", lw=2.0, marker="o", label="median realised stride per 0.05 m/s bin")
     v = np.linspace(1e-3, 1.1 * v_max, 200)
     for creature, h in sorted(heights):
-        ax.plot(v, target_stride_length(v, h), c="k", lw=1.8, label=f"target 2.3 h Fr^0.3 ({creature}, h = {h:.3f} m)")
+        ax.plot(v, target_stride_length(v, h, creature), c="k", lw=1.8,
+                label=f"target 2.3 h Fr^0.3 ({creature}, h = {h:.3f} m)")
     ax.set_xlabel("speed v (m/s), pelvis over the stride")
     ax.set_ylabel("stride length λ (m), same foot, one cycle")
     ax.set_title("Stride length vs speed")

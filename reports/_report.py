@@ -22,7 +22,7 @@ import numpy as np
 
 from footfall._atomic import unwritable_reason
 from footfall._errors import InputError
-from reports._distribute import check_workers, run_tasks
+from footfall._distribute import check_workers, run_tasks
 from reports import _html, _pareto, _plots, _sweep
 
 REPORT_FORMAT = "footfall-report"
@@ -155,7 +155,7 @@ def build_report(out, *, preset: str = "default", scenarios: tuple[str, ...] | N
 
     ``progress(description, completed, total)`` is called as work advances;
     ``warn(message)`` for problems that do not stop the report (a failed render).
-    ``workers`` / ``cluster``: where the sweep's tasks run (:mod:`reports._distribute`:
+    ``workers`` / ``cluster``: where the sweep's tasks run (:mod:`footfall._distribute`:
     one local worker process per core by default, ``workers=1`` in this process, or the
     workers of a Dask scheduler); the metrics do not depend on it.
     """

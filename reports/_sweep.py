@@ -33,6 +33,7 @@ requests of a frame are read from the crowd's state after the frame
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import time
 
@@ -279,12 +280,22 @@ def curvature_energy(points: np.ndarray, window=CURVATURE_WINDOW) -> float:
     return total * energy
 
 
-def target_stride_length(speed, hip_height: float):
-    """The biomechanics target lambda = 2.3 h Fr^0.3, Fr = v^2 / (g h) (Alexander 1976), m."""
+def target_stride_length(speed, hip_height: float, creature: str = "spider"):
+    """The biomechanics target lambda = coefficient h Fr^exponent, Fr = v^2 / (g h), m: the
+    creature's ``stride_length`` entry of ``tuning/data/targets.toml`` (2.3 h Fr^0.3, Alexander
+    1976), the one definition the tuning fits to (``tuning._targets`` does not load JAX)."""
     from planner._timing import GRAVITY
 
+    t = _stride_target(creature)
     v = np.asarray(speed, dtype=np.float64)
-    return 2.3 * hip_height * np.power(v * v / (GRAVITY * hip_height), 0.3)
+    return t["coefficient"] * hip_height * np.power(v * v / (GRAVITY * hip_height), t["exponent"])
+
+
+@functools.lru_cache(maxsize=None)
+def _stride_target(creature: str) -> dict:
+    from tuning._targets import load_targets
+
+    return dict(load_targets(creatures=(creature,))[creature]["stride_length"].values)
 
 
 def _load_inputs(scenario_name: str):
@@ -344,7 +355,7 @@ def _run_setting(task: dict) -> dict:
     speeds, strides = realised_strides(a["feet"], a["in_stance"], a["pelvis"], model.dt)
     walking = speeds > STRIDE_MIN_SPEED
     speeds, strides = speeds[walking], strides[walking]
-    target = target_stride_length(speeds, model.leg_height)
+    target = target_stride_length(speeds, model.leg_height, model.creature.name)
     error = (strides - target) / target if strides.size else np.zeros(0)
     keep = np.linspace(0, strides.size - 1, min(strides.size, STRIDE_SAMPLES_KEPT)).astype(int) if strides.size else []
     curv = np.asarray(tap.curvature)

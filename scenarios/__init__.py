@@ -11,7 +11,14 @@ formats are described in ``scenarios/README.md``.
 """
 
 from scenarios._creatures import Creature
-from scenarios._files import builtin_creature_names, builtin_scenario_names, load_creature, load_scenario
+from scenarios._files import (
+    builtin_creature_names,
+    builtin_scenario_names,
+    load_creature,
+    load_scenario,
+    split_variant,
+    variant_name,
+)
 from scenarios._gaits import (
     Gait,
     builtin_gait_names,
@@ -53,6 +60,8 @@ __all__ = [
     "load_creature",
     "load_gait",
     "load_scenario",
+    "split_variant",
+    "variant_name",
     "min_stance_feet",
     "random_crates",
     "required_stance_feet",

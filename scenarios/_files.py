@@ -184,14 +184,60 @@ def _load_creature_file(path: Path, file: str) -> Creature:
 # --------------------------------------------------------------------------- scenarios
 
 
+def split_variant(spec: str) -> tuple[str, dict[str, Any]]:
+    """``"NAME@key=value,key=value"`` -> (NAME, {dotted key: value}); values are TOML scalars.
+
+    A *variant* is a scenario with a few of its file's values replaced, in memory: ``hills@seed=3``
+    (the same kind of terrain from another seed), ``flat@crowd.speed=0.12``. It is a plain string,
+    so a task sent to another machine carries it and loads the same scenario there.
+    """
+    name, _, rest = spec.partition("@")
+    overrides: dict[str, Any] = {}
+    for item in filter(None, rest.split(",")):
+        key, eq, value = item.partition("=")
+        if not eq or not key.strip():
+            raise InputError(spec, "scenario", f"variant {item!r}: expected key=value")
+        try:
+            overrides[key.strip()] = tomllib.loads(f"v = {value.strip()}")["v"]
+        except tomllib.TOMLDecodeError:
+            raise InputError(spec, "scenario", f"variant {item!r}: {value.strip()!r} is not a TOML value") from None
+    return name, overrides
+
+
+def variant_name(name: str, **overrides: Any) -> str:
+    """The variant string of ``name`` with ``overrides`` (dotted keys as keyword names with ``__``
+    for dots: ``variant_name("hills", seed=3, crowd__speed=0.1)``); floats written exactly."""
+    items = [f"{k.replace('__', '.')}={v!r}" for k, v in overrides.items()]
+    return name + ("@" + ",".join(items) if items else "")
+
+
+def _apply_overrides(data: dict[str, Any], overrides: dict[str, Any], file: str) -> dict[str, Any]:
+    for key, value in overrides.items():
+        *tables, leaf = key.split(".")
+        node = data
+        for t in tables:
+            node = node.get(t)
+            if not isinstance(node, dict):
+                raise InputError(file, key, "no such table in the scenario to override")
+        node[leaf] = value
+    return data
+
+
 def load_scenario(name_or_path: str | Path) -> Scenario:
-    """A built-in scenario by name (see :func:`builtin_scenario_names`) or a scenario ``.toml`` file.
+    """A built-in scenario by name (see :func:`builtin_scenario_names`), a scenario ``.toml`` file, or
+    a variant of either, ``NAME@key=value,...`` (:func:`split_variant`).
 
     Paths inside the file (height maps, creature files) are relative to the
     file. Raises :class:`InputError` naming the file and field on any problem.
     """
+    overrides: dict[str, Any] = {}
+    if isinstance(name_or_path, str) and "@" in name_or_path and not _is_file(Path(name_or_path)):
+        name_or_path, overrides = split_variant(name_or_path)
     path, file = _resolve(name_or_path, DATA_DIR, builtin_scenario_names(), "scenario")
-    model: schema.ScenarioFile = schema.validate(schema.ScenarioFile, _read_toml(path, file, "scenario"), file)
+    if overrides:
+        file = variant_name(file, **{k.replace(".", "__"): v for k, v in overrides.items()})
+    data = _apply_overrides(_read_toml(path, file, "scenario"), overrides, file)
+    model: schema.ScenarioFile = schema.validate(schema.ScenarioFile, data, file)
     base = path.parent
 
     terrain = _attributed(file, "terrain", lambda: _build_terrain(model.terrain, model.seed, base, file))

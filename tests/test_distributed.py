@@ -10,7 +10,7 @@ import time
 import pytest
 
 from footfall._errors import InputError
-from reports._distribute import check_workers, run_tasks
+from footfall._distribute import check_workers, run_tasks
 from reports._sweep import PRESETS, build_tasks, run_task, without_timings
 
 

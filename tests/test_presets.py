@@ -49,3 +49,25 @@ def test_cli_refuses_a_preset_for_another_creature(tmp_path):
                            str(path)], capture_output=True, text=True, timeout=600)
     assert proc.returncode == 2 and str(path) in proc.stderr and "creature" in proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1
+
+
+def test_cli_takes_a_shipped_preset_by_name_and_refuses_an_unknown_name():
+    def simulate(preset):
+        return subprocess.run([sys.executable, "-m", "footfall.cli", "simulate", "flat", "--frames", "3", "--preset",
+                               preset, "--json"], capture_output=True, text=True, timeout=600)
+
+    proc = simulate("spider")
+    assert proc.returncode == 0, proc.stderr
+    assert json.loads(proc.stdout)["frames"] == 3
+    proc = simulate("spidr")
+    assert proc.returncode == 2 and "--preset" in proc.stderr and "spider" in proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1
+    proc = simulate("ant")  # a shipped preset of another creature
+    assert proc.returncode == 2 and "ant.json" in proc.stderr and "creature" in proc.stderr
+
+
+def test_importing_tuning_for_its_presets_and_targets_does_not_load_jax():
+    code = ("import sys, tuning, tuning._targets; tuning.PRESETS_DIR; tuning._targets.load_targets(); "
+            "assert 'jax' not in sys.modules, 'jax loaded'")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr

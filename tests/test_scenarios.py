@@ -582,3 +582,26 @@ def test_creature_constructor_validation():
     with pytest.raises(InputError):
         dataclasses.replace(spider, leg_names=(), hips=np.zeros((0, 3)))
     assert isinstance(spider, Creature)
+
+
+def test_a_variant_replaces_values_of_the_file_in_memory():
+    base = load_scenario("hills")
+    other = load_scenario("hills@seed=3")
+    assert other.seed == 3 and base.seed != 3
+    # Another terrain from the same generator: same kind and size, other heights.
+    assert other.terrain.heights.shape == base.terrain.heights.shape
+    assert not np.array_equal(other.terrain.heights, base.terrain.heights)
+    again = load_scenario(scenarios.variant_name("hills", seed=3))
+    assert np.array_equal(again.terrain.heights, other.terrain.heights)
+    fast = load_scenario(scenarios.variant_name("hills", seed=3, crowd__speed=0.125))
+    assert fast.crowd.speed == 0.125 and np.array_equal(fast.terrain.heights, other.terrain.heights)
+    assert scenarios.split_variant("flat@crowd.speed=0.5,seed=2") == ("flat", {"crowd.speed": 0.5, "seed": 2})
+
+
+@pytest.mark.parametrize("spec, field", [("hills@seed", "scenario"), ("hills@nope.x=1", "nope.x"),
+                                         ("hills@crowd.speed=-1", "crowd.speed"), ("hills@seed=abc", "scenario"),
+                                         ("hills@crowd.bogus=1", "bogus"), ("lava@seed=1", "scenario")])
+def test_a_bad_variant_names_the_field(spec, field):
+    with pytest.raises(InputError) as info:
+        load_scenario(spec)
+    assert field in info.value.field and spec.split("@")[0] in str(info.value)

@@ -32,7 +32,6 @@ def test_the_stride_residuals_are_the_targets_law(problem):
     r = np.asarray(_fit.residuals(_fit.initial_params(problem), problem))
     mask = np.asarray(problem.stride_mask)
     assert mask.sum() > 10
-    metrics = tuning.expected_metrics(s.weights0, s.timing0, s, TAU)
     targets = tuning.load_targets(creatures=("spider", "ant"))
     names = ("spider", "ant")
     v = np.asarray(s.speed)
@@ -42,9 +41,65 @@ def test_the_stride_residuals_are_the_targets_law(problem):
     np.testing.assert_allclose(law, 2.3 * h * (v * v / (GRAVITY * h)) ** 0.3, rtol=1e-14)
     tolerance = np.array([targets[names[c]]["stride_length"].values["relative_tolerance"]
                           for c in np.asarray(s.creature)])
-    expected = (np.asarray(metrics["step_length_m"]) / law - 1.0) / tolerance / np.sqrt(mask.sum())
+    # The commanded stride v / f, f = max(v / lambda_timing(v), min_frequency) (planner._timing), by hand.
+    t = GaitTiming.from_array(np.asarray(s.timing0))
+    timing_law = t.stride_coefficient * h * (v * v / (GRAVITY * h)) ** t.stride_exponent
+    commanded = v / np.maximum(v / np.where(v > 0, timing_law, 1.0), t.min_frequency_hz)
+    expected = (commanded / law - 1.0) / tolerance / np.sqrt(mask.sum())
     np.testing.assert_allclose(r[:s.n_situations][mask], expected[mask], rtol=0, atol=RESIDUAL_ATOL)
     assert (r[:s.n_situations][~mask] == 0.0).all()
+
+
+def test_the_stride_correction_scales_the_commanded_stride(problem):
+    """c = realised / commanded (output space mapping): the fit asks c lambda_cmd for the target."""
+    import dataclasses
+
+    import jax.numpy as jnp
+
+    from tuning import _fit
+
+    s = problem.situations
+    mask = np.asarray(problem.stride_mask)
+    c = np.linspace(0.8, 1.25, s.n_situations)
+    corrected = dataclasses.replace(problem, stride_correction=jnp.asarray(c))
+    r0 = np.asarray(_fit.residuals(_fit.initial_params(problem), problem))[:s.n_situations]
+    r1 = np.asarray(_fit.residuals(_fit.initial_params(corrected), corrected))[:s.n_situations]
+    tolerance = 0.15 * np.sqrt(mask.sum())  # relative_tolerance times the block normalisation
+    # (c x / t - 1) / tol = c (x / t - 1) / tol + (c - 1) / tol
+    np.testing.assert_allclose(r1[mask], c[mask] * r0[mask] + (c[mask] - 1.0) / tolerance, rtol=0, atol=1e-11)
+    with pytest.raises(ValueError, match="stride_correction"):
+        _fit.make_problem(s, ("spider", "ant"), _targets(), TAU, stride_correction=np.zeros(s.n_situations))
+
+
+def test_the_duty_correction_shifts_the_duty_model(problem):
+    """d = realised - commanded duty factor: the fit's duty model is DF(theta) + d."""
+    import dataclasses
+
+    import jax.numpy as jnp
+
+    import tuning
+    from tuning import _fit
+
+    s = problem.situations
+    mask = np.asarray(problem.duty_mask)
+    assert mask.any()
+    d = np.full(s.n_situations, -0.3)  # far below every band
+    shifted = dataclasses.replace(problem, duty_correction=jnp.asarray(d))
+    r = np.asarray(_fit.residuals(_fit.initial_params(shifted), shifted))
+    block = r[s.n_situations:2 * s.n_situations]
+    duty = np.asarray(tuning.duty_factor(s.timing0, s.speed, s.leg_height)) + d
+    low, high = np.asarray(problem.duty_low), np.asarray(problem.duty_high)
+    expected = np.maximum(low - duty, 0.0) / (high - low) / np.sqrt(mask.sum())
+    np.testing.assert_allclose(block[mask], expected[mask], rtol=0, atol=1e-12)
+    assert (block[mask] > 0).all()
+    with pytest.raises(ValueError, match="duty_correction"):
+        _fit.make_problem(s, ("spider", "ant"), _targets(), TAU, duty_correction=np.full(s.n_situations, 2.0))
+
+
+def _targets():
+    import tuning
+
+    return tuning.load_targets(creatures=("spider", "ant"))
 
 
 def test_levenberg_marquardt_lowers_the_loss_and_keeps_parameters_valid(problem):

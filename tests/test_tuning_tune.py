@@ -1,6 +1,6 @@
 """Tuning's outer loop and presets (issue 4, items 4-6): a tiny tune run writes a valid preset,
-a killed run resumed gives the same bytes, shipped presets load for their creature only, and the
-shipped spider preset beats the default weights on held-out runs."""
+a killed run resumed gives the same bytes (on local workers and in-process), shipped presets load
+for their creature only, and what the shipped presets do on held-out runs."""
 
 import json
 import subprocess
@@ -25,8 +25,8 @@ def _tiny(**changes):
     from tuning._tune import TuneConfig
 
     settings = dict(rounds=2, harvest_frames=20, harvest_characters=1, max_situations=40, fit_steps=3,
-                    exact_scenarios=("flat",), exact_seeds=(0,), exact_frames=75, froude=(0.01, 0.03), holdout_scenarios=("hills",),
-                    holdout_seeds=(5,))
+                    exact_scenarios=("flat",), exact_seeds=(0,), exact_frames=75, exact_characters=1,
+                    froude=(0.01, 0.03), holdout_scenarios=("hills@seed=2",), holdout_seeds=(5,))
     settings.update(changes)
     return TuneConfig("spider", **settings)
 
@@ -38,11 +38,11 @@ def tiny_runs(tmp_path_factory):
 
     folder = tmp_path_factory.mktemp("tune")
     config = _tiny()
-    whole = tune(config, folder / "whole.json")
-    killed = tune(config, folder / "killed.json", stop_after=1)
+    whole = tune(config, folder / "whole.json", workers=2)  # on local worker processes
+    killed = tune(config, folder / "killed.json", stop_after=1, workers=1)  # in-process
     after_kill = checkpoint_path(folder / "killed.json").read_text()
     assert not (folder / "killed.json").exists()
-    resumed = tune(config, folder / "killed.json", resume=True)
+    resumed = tune(config, folder / "killed.json", resume=True, workers=1)
     return folder, config, whole, killed, after_kill, resumed
 
 
@@ -74,21 +74,24 @@ def test_bad_checkpoints_and_arguments_are_refused(tiny_runs, tmp_path):
 
     folder, config, _, _, _, _ = tiny_runs
     with pytest.raises(InputError, match="no checkpoint"):
-        tune(config, tmp_path / "none.json", resume=True)
+        tune(config, tmp_path / "none.json", resume=True, workers=1)
     bad = tmp_path / "bad.json"
     checkpoint_path(bad).write_text("{not json")
     with pytest.raises(InputError, match="corrupt"):
-        tune(config, bad, resume=True)
+        tune(config, bad, resume=True, workers=1)
     with pytest.raises(InputError, match="other settings"):
-        tune(_tiny(seed=3), folder / "whole.json", resume=True)
+        tune(_tiny(seed=3), folder / "whole.json", resume=True, workers=1)
     with pytest.raises(InputError, match="--creature"):
-        tune(_tiny().__class__("octopus"), tmp_path / "o.json")
+        tune(_tiny().__class__("octopus"), tmp_path / "o.json", workers=1)
 
 
 def test_cli_refuses_bad_input_with_one_line():
     for args, field in ((["--creature", "octopus"], "--creature"),
                         (["--creature", "spider", "--out", "/proc/nope/spider.json"], "--out"),
-                        (["--creature", "spider", "--out", "spider.txt"], "--out")):
+                        (["--creature", "spider", "--out", "spider.txt"], "--out"),
+                        (["--creature", "spider", "--workers", "0"], "--workers"),
+                        (["--creature", "spider", "--cluster", "nonsense"], "--cluster"),
+                        (["--creature", "spider", "--cluster", "tcp://127.0.0.1:1", "--workers", "2"], "--workers")):
         proc = subprocess.run([sys.executable, "-m", "footfall.cli", "tune", *args], capture_output=True, text=True,
                               timeout=300)
         assert proc.returncode == 2, proc.stderr
@@ -145,16 +148,35 @@ def test_shipped_presets_meet_the_stride_target_on_held_out_runs_without_collisi
     assert summary["stride_rel_error_tuned"] <= summary["stride_rel_error_default"]
 
 
-def test_the_robot5_preset_beats_the_defaults_on_held_out_runs():
-    losses = load_preset(PRESETS / "robot5.json", "robot5").provenance["losses"]
-    assert losses["heldout_tuned"]["stride_rel_error"] < losses["heldout_default"]["stride_rel_error"]
-    assert losses["heldout_tuned"]["curvature_energy_mean"] <= losses["heldout_default"]["curvature_energy_mean"]
+@pytest.mark.parametrize("creature", [
+    "spider", "robot5",
+    pytest.param("ant", marks=pytest.mark.xfail(strict=True, reason=(
+        "known shortfall (issue 4 item 6): the ant's strides are long only at the top speed of the sweep, "
+        "where it cannot keep up (a kink the power-law timing cannot follow); the fit shortens every "
+        "stride, which wins on the training runs and loses 0.007 on the held-out ones"))),
+    pytest.param("quadruped", marks=pytest.mark.xfail(strict=True, reason=(
+        "known shortfall (issue 4 item 6): no candidate beat the defaults on the training runs, so the "
+        "preset keeps them (held-out error equal, 2.7 %: no systematic error left to remove)"))),
+])
+def test_the_shipped_preset_beats_the_defaults_on_held_out_runs(creature):
+    """Stride error lower than the default weights' on scenarios the fit did not see, no collisions,
+    curvature energy not risen beyond its sampling noise (tuning._tune.curvature_limit)."""
+    from tuning._tune import curvature_limit
+
+    losses = load_preset(PRESETS / f"{creature}.json", creature).provenance["losses"]
+    held_default, held_tuned = losses["heldout_default"], losses["heldout_tuned"]
+    assert held_tuned["stride_rel_error"] < held_default["stride_rel_error"]
+    assert held_tuned["collisions"] == 0
+    assert held_tuned["curvature_energy_mean"] <= curvature_limit(held_default, held_tuned)
 
 
-@pytest.mark.xfail(strict=True, reason="known shortfall (issue 4 item 6): the tuned spider preset lowers the stride "
-                   "error on the runs it was selected on (flat, hills), not on held-out runs (stairs, mixed), and one "
-                   "held-out swing curves; see the preset's provenance")
-def test_the_spider_preset_beats_the_defaults_on_held_out_runs():
-    losses = _spider_preset().provenance["losses"]
-    assert losses["heldout_tuned"]["stride_rel_error"] < losses["heldout_default"]["stride_rel_error"]
-    assert losses["heldout_tuned"]["curvature_energy_mean"] <= losses["heldout_default"]["curvature_energy_mean"]
+def test_a_preset_that_kept_the_defaults_is_the_defaults():
+    """The quadruped's tune accepted no candidate: its preset must be the defaults, bit for bit, and
+    its held-out numbers those of the defaults (the runs are deterministic)."""
+    from planner import GaitTiming, ScoringWeights
+
+    preset = load_preset(PRESETS / "quadruped.json", "quadruped")
+    assert preset.provenance["summary"]["best_round"] == -1
+    assert preset.weights == ScoringWeights() and preset.timing == GaitTiming()
+    losses = preset.provenance["losses"]
+    assert losses["heldout_tuned"] == losses["heldout_default"]

@@ -18,69 +18,38 @@
 tuning/ computes in float64: its entry points call :func:`enable_x64`.
 """
 
+from importlib import import_module
 from pathlib import Path
 
-from tuning._config import enable_x64
-from tuning._fit import FITTED_TIMING, FitProblem, fit, loss, make_problem, residuals
-from tuning._proxies import (
-    PROXY_METRICS,
-    Situations,
-    couple_scores,
-    duty_factor,
-    expected_metrics,
-    hard_metrics,
-    preferred_footprint,
-    preferred_lead_time,
-    situations_from_harvest,
-    soft_selection,
-    stride_frequency,
-    stride_length,
-)
-from tuning._targets import QUANTITIES, TARGETS_FILE, CreatureTargets, Target, load_targets
-from tuning._scoring import (
-    couple_score,
-    couple_terms,
-    footprint_goodness,
-    footprint_score,
-    trajectory_goodness,
-    trajectory_score,
-    weighted_mean,
-)
-
 PRESETS_DIR = Path(__file__).resolve().parent / "data" / "presets"
-"""The shipped, tuned presets (``footfall simulate --preset tuning/data/presets/spider.json``)."""
+"""The shipped, tuned presets (``footfall simulate --preset spider`` or ``--preset FILE``)."""
 
-__all__ = [
-    "PRESETS_DIR",
-    "FITTED_TIMING",
-    "FitProblem",
-    "fit",
-    "loss",
-    "make_problem",
-    "residuals",
-    "PROXY_METRICS",
-    "QUANTITIES",
-    "TARGETS_FILE",
-    "CreatureTargets",
-    "Target",
-    "load_targets",
-    "Situations",
-    "couple_score",
-    "couple_scores",
-    "couple_terms",
-    "duty_factor",
-    "enable_x64",
-    "expected_metrics",
-    "footprint_goodness",
-    "footprint_score",
-    "hard_metrics",
-    "preferred_footprint",
-    "preferred_lead_time",
-    "situations_from_harvest",
-    "soft_selection",
-    "stride_frequency",
-    "stride_length",
-    "trajectory_goodness",
-    "trajectory_score",
-    "weighted_mean",
-]
+# Lazy re-exports (PEP 562): ``import tuning`` and the JAX-free modules (``tuning._targets``)
+# must not load JAX, so that the report and the CLI can read the targets and the shipped
+# presets without it. A name is imported from its module on first use.
+_EXPORTS = {
+    "enable_x64": "_config",
+    **dict.fromkeys(("FITTED_TIMING", "FitProblem", "fit", "loss", "make_problem", "residuals"), "_fit"),
+    **dict.fromkeys(("PROXY_METRICS", "Situations", "couple_scores", "duty_factor", "expected_metrics",
+                     "hard_metrics", "preferred_footprint", "preferred_lead_time", "situations_from_harvest",
+                     "soft_selection", "stride_frequency", "stride_length"), "_proxies"),
+    **dict.fromkeys(("QUANTITIES", "TARGETS_FILE", "CreatureTargets", "Target", "load_targets"), "_targets"),
+    **dict.fromkeys(("couple_score", "couple_terms", "footprint_goodness", "footprint_score", "trajectory_goodness",
+                     "trajectory_score", "weighted_mean"), "_scoring"),
+}
+
+
+def __getattr__(name: str):
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'tuning' has no attribute {name!r}")
+    value = getattr(import_module(f"tuning.{module}"), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_EXPORTS))
+
+
+__all__ = ["PRESETS_DIR", *_EXPORTS]

@@ -175,6 +175,8 @@ def run_one(creature_name: str, scenario_name: str, seed: int, speed: float, wei
             "leg_height": float(model.leg_height)}
 
 
+# Worker-local state, but only a cache: a raster is rebuilt deterministically from the scenario
+# and the cell size, so a task gives the same run whether or not its process built it before.
 _RASTERS: dict = {}
 
 
@@ -187,14 +189,61 @@ def _raster(name, cell, scenario):
     return _RASTERS[key]
 
 
-def exact_metrics(setup: ExactSetup, weights=None, timing=None, targets=None) -> dict:
-    """Run the sweep and return the exact loss with its parts (plain numbers, JSON-ready)."""
+def exact_tasks(setup: ExactSetup, weights=None, timing=None) -> list[dict]:
+    """One plain-dict task per scenario x seed x speed of the sweep, in the order the runs are merged.
+
+    Parameters travel as lists of floats (``weights`` None: the planner's defaults), so a task
+    carries every input of its run and gives the same result wherever it runs.
+    """
+    from planner._timing import GaitTiming
+
+    timing = timing or GaitTiming()
+    speeds = speeds_for(setup)
+    w = None if weights is None else [float(x) for x in weights.to_array()]
+    t = [float(x) for x in timing.to_array()]
+    return [{"creature": setup.creature, "scenario": scenario, "seed": int(seed), "froude": float(fr),
+             "speed": float(v), "weights": w, "timing": t, "frames": int(setup.frames), "warmup": int(setup.warmup),
+             "n_characters": int(setup.n_characters)}
+            for scenario in setup.scenarios
+            for seed in setup.seeds
+            for fr, v in zip(setup.froude, speeds)]
+
+
+def run_exact_task(task: dict) -> dict:
+    """:func:`run_one` for a task of :func:`exact_tasks`, tagged with its scenario, seed and speed.
+    The result holds numpy arrays (``speed``, ``stride``, ``raw``): picklable, for a worker to send back."""
     import numba
 
     from planner._timing import GaitTiming
+    from planner._weights import ScoringWeights
+
+    weights = None if task["weights"] is None else ScoringWeights.from_array(task["weights"])
+    timing = GaitTiming.from_array(task["timing"])
+    threads = numba.get_num_threads()
+    numba.set_num_threads(1)  # small crowds: one core is faster and leaves the other to others
+    try:
+        r = run_one(task["creature"], task["scenario"], task["seed"], task["speed"], weights, timing, task["frames"],
+                    task["warmup"], task["n_characters"])
+    finally:
+        numba.set_num_threads(threads)
+    r.update(scenario=task["scenario"], seed=task["seed"], froude=task["froude"], desired_speed=task["speed"])
+    return r
+
+
+def exact_metrics(setup: ExactSetup, weights=None, timing=None, targets=None, map_tasks=None) -> dict:
+    """Run the sweep and return the exact loss with its parts (plain numbers, JSON-ready).
+
+    Each run is a task (:func:`exact_tasks`, :func:`run_exact_task`); ``map_tasks(function, tasks)
+    -> list`` (results in task order, e.g. from ``footfall._distribute.task_runner``) runs them, on
+    workers or not; None runs them here, one after the other. The result is the same, bit for bit.
+    """
+    from planner._timing import GaitTiming
+    from planner._timing import duty_factor as commanded_duty
     from planner._timing import stride_length as commanded_stride
     from tuning._targets import load_targets
 
+    if map_tasks is not None and not callable(map_tasks):
+        raise ValueError(f"map_tasks: expected None or a callable, got {type(map_tasks).__name__}")
     timing = timing or GaitTiming()
 
     targets = targets or load_targets(creatures=(setup.creature,))
@@ -204,21 +253,12 @@ def exact_metrics(setup: ExactSetup, weights=None, timing=None, targets=None) ->
     curvature_max = t["curvature_energy"].values["maximum"]
     clearance_min = t.clearance_min_m
     jerk_max = t["swing_jerk"].values["maximum"]
-    speeds = speeds_for(setup)
     h = t.leg_length_m
-    runs = []
-    threads = numba.get_num_threads()
-    numba.set_num_threads(1)  # small crowds: one core is faster and leaves the other to others
-    try:
-        for scenario in setup.scenarios:
-            for seed in setup.seeds:
-                for fr, v in zip(setup.froude, speeds):
-                    r = run_one(setup.creature, scenario, seed, float(v), weights, timing, setup.frames,
-                                setup.warmup, setup.n_characters)
-                    r.update(scenario=scenario, seed=int(seed), froude=float(fr), desired_speed=float(v))
-                    runs.append(r)
-    finally:
-        numba.set_num_threads(threads)
+    tasks = exact_tasks(setup, weights, timing)
+    if map_tasks is None:
+        runs = [run_exact_task(task) for task in tasks]
+    else:
+        runs = list(map_tasks(run_exact_task, tasks))
     ratios, duty_out, per_run = [], [], []
     raw_all = np.concatenate([r["raw"] for r in runs]) if runs else np.zeros((0, 5))
     for r in runs:
@@ -230,6 +270,9 @@ def exact_metrics(setup: ExactSetup, weights=None, timing=None, targets=None) ->
         else:
             ratio = commanded = math.nan
         duty = r["stance_fraction"]
+        # The duty factor the timing commanded at the speeds the pelvis realised (the gait manager
+        # uses the crowd's speed): the fit corrects its duty model by what was realised.
+        duty_cmd = float(np.mean(commanded_duty(timing, r["speed"], h))) if r["speed"].size else math.nan
         out = 0.0
         if r["froude"] < duty_t["froude_max"]:
             out = (max(0.0, duty_t["low"] - duty) + max(0.0, duty - duty_t["high"])) / (duty_t["high"] - duty_t["low"])
@@ -239,7 +282,8 @@ def exact_metrics(setup: ExactSetup, weights=None, timing=None, targets=None) ->
                         "realised_speed": float(np.mean(r["speed"])) if r["speed"].size else 0.0,
                         "strides": int(r["stride"].size), "stride_ratio": None if math.isnan(ratio) else ratio,
                         "commanded_ratio": None if math.isnan(commanded) else commanded,
-                        "duty_factor": duty, "collisions": r["collisions"]})
+                        "duty_factor": duty, "commanded_duty": None if math.isnan(duty_cmd) else duty_cmd,
+                        "collisions": r["collisions"]})
     if not ratios:
         raise RuntimeError(f"exact loss: no strides measured for {setup.creature} (too few frames?)")
     ratios = np.asarray(ratios)
@@ -247,6 +291,9 @@ def exact_metrics(setup: ExactSetup, weights=None, timing=None, targets=None) ->
     stride_term = float(np.mean(((ratios - 1.0) / tol) ** 2))
     duty_term = float(np.mean(np.square(duty_out)))
     curvature = float(np.mean(raw_all[:, RAW_CURVATURE])) if raw_all.size else 0.0
+    # Standard error of that mean: a few detours around a crate or a hill carry most of it, so it
+    # moves by tens of per cent between runs of nearly the same parameters (tuning._tune's guard).
+    curvature_se = float(np.std(raw_all[:, RAW_CURVATURE]) / math.sqrt(raw_all.shape[0])) if raw_all.size else 0.0
     clearance_raw = raw_all[:, RAW_CLEARANCE] if raw_all.size else np.zeros(0)
     capped = np.where(np.isfinite(clearance_raw), np.minimum(clearance_raw, clearance_min), clearance_min)
     clearance = float(np.mean(capped)) if capped.size else clearance_min
@@ -260,7 +307,7 @@ def exact_metrics(setup: ExactSetup, weights=None, timing=None, targets=None) ->
     return {
         "exact_loss": float(loss), "stride_rel_error": float(np.mean(np.abs(ratios - 1.0))),
         "stride_ratio": [float(x) for x in ratios], "stride_term": stride_term, "duty_term": duty_term,
-        "curvature_energy_mean": curvature, "curvature_term": curvature_term, "clearance_mean_m": clearance,
+        "curvature_energy_mean": curvature, "curvature_energy_se": curvature_se, "curvature_term": curvature_term, "clearance_mean_m": clearance,
         "clearance_term": clearance_term, "jerk_median": jerk, "collisions": collisions,
         "finite": all(r["finite"] for r in runs), "plans": int(raw_all.shape[0]), "leg_height_m": h,
         "runs": per_run,

@@ -10,10 +10,23 @@ Residuals (a fixed-length vector; masked situations contribute zeros), each bloc
 divided by the square root of its count so that every target weighs the same
 whatever the number of situations:
 
-* stride: new swings of a moving creature, (E[step] / lambda_target(v) - 1) / tolerance,
-  lambda_target = coefficient h Fr^exponent (tuning/data/targets.toml);
-* duty factor: distance of DF(v; theta) outside the band [low, high], / (high - low),
-  for Fr < froude_max;
+* stride: new swings of a moving creature, (c lambda_cmd(theta, v) / lambda_target(v) - 1) / tolerance,
+  lambda_target = coefficient h Fr^exponent (tuning/data/targets.toml), lambda_cmd(theta, v) = v / f(v)
+  the stride the timing commands (``tuning._proxies.stride_frequency``) and c = ``stride_correction``
+  (per situation; 1 by default) the realised / commanded stride the exact planner measured under the
+  current parameters (output space mapping, :mod:`tuning._tune`). Why the commanded stride and not
+  the soft selection's expected step E[|x - source|]: in steady walking every footprint lands at its
+  preferred footprint P plus an offset that the weights decide, and a stride is the distance between
+  two consecutive touch-downs of one foot, so the offsets cancel and the mean stride is the P spacing
+  v / f, set by the timing alone. The per-situation E[step] moves with the weights by the offset
+  (which the next step takes back), and with the timing only through how the soft selection leans
+  toward a P that moved over fixed candidates -- far more weakly than the runtime, which re-centres
+  its candidates on P: fitting it over-stepped the timing by about 4 times (spider: stride exponent
+  0.30 -> 0.39 for a 5 % shorter stride). E[step] stays a reported metric (``step_length_m``);
+* duty factor: distance of DF(v; theta) + d outside the band [low, high], / (high - low),
+  for Fr < froude_max; d = ``duty_correction`` (per situation; 0 by default) the realised stance
+  fraction minus the commanded DF that the exact planner measured under the current parameters
+  (output space mapping, as for the stride: swings that start late or re-plan, holds);
 * duty slope: max(0, -duty_slope - max_slope) (DF falls with speed);
 * per creature, on the mean over its situations (a population target: a detour
   around a crate is sometimes the only way, and must not dominate the fit):
@@ -45,7 +58,7 @@ import numpy as np
 import optimistix as optx
 
 from planner._timing import GRAVITY, TIMING_FIELDS
-from tuning._proxies import Situations, duty_factor, expected_metrics
+from tuning._proxies import Situations, duty_factor, expected_metrics, stride_frequency
 
 FITTED_TIMING = ("stride_coefficient", "stride_exponent", "duty_at_rest", "duty_slope")
 _FITTED_INDEX = np.array([TIMING_FIELDS.index(n) for n in FITTED_TIMING])
@@ -61,9 +74,11 @@ class FitProblem(eqx.Module):
     stride_target_m: jax.Array
     stride_tolerance: jax.Array
     stride_mask: jax.Array
+    stride_correction: jax.Array  # (F,) c: realised / commanded stride measured by the exact planner
     duty_low: jax.Array
     duty_high: jax.Array
     duty_mask: jax.Array
+    duty_correction: jax.Array  # (F,) d: realised stance fraction - commanded duty factor
     max_duty_slope: jax.Array  # () the smallest over the creatures
     jerk_max: jax.Array
     curvature_max: jax.Array
@@ -74,10 +89,13 @@ class FitProblem(eqx.Module):
     jerk_weight: jax.Array  # () weight of the jerk block (0 by default: module docstring)
 
 
-def make_problem(situations: Situations, creature_names, targets, tau: float, jerk_weight: float = 0.0) -> FitProblem:
+def make_problem(situations: Situations, creature_names, targets, tau: float, jerk_weight: float = 0.0,
+                 stride_correction=None, duty_correction=None) -> FitProblem:
     """``creature_names``: the harvest's ``creatures`` (``situations.creature`` indexes it);
     ``targets``: :func:`tuning.load_targets` output holding those creatures; ``jerk_weight``:
-    weight of the jerk block (0: off, the default; module docstring)."""
+    weight of the jerk block (0: off, the default; module docstring); ``stride_correction``:
+    c per situation (F,), realised / commanded stride (None: 1, the timing model taken at its word);
+    ``duty_correction``: d per situation (F,), realised - commanded duty factor (None: 0)."""
     if not tau > 0.0:
         raise ValueError(f"tau: expected a temperature > 0, got {tau!r}")
     if isinstance(jerk_weight, bool) or not isinstance(jerk_weight, (int, float)) or not jerk_weight >= 0.0:
@@ -98,12 +116,21 @@ def make_problem(situations: Situations, creature_names, targets, tau: float, je
     duty_fr = col(lambda t: t["duty_factor"].values["froude_max"])
     timing0 = np.asarray(situations.timing0)
     weights0 = np.asarray(situations.weights0)
+    if stride_correction is None:
+        stride_correction = np.ones(v.shape)
+    stride_correction = np.asarray(stride_correction, dtype=np.float64)
+    if stride_correction.shape != v.shape or not (np.isfinite(stride_correction).all() and (stride_correction > 0).all()):
+        raise ValueError(f"stride_correction: expected {v.shape[0]} positive finite numbers")
+    duty_correction = np.zeros(v.shape) if duty_correction is None else np.asarray(duty_correction, dtype=np.float64)
+    if duty_correction.shape != v.shape or not (np.isfinite(duty_correction).all() and (abs(duty_correction) < 1).all()):
+        raise ValueError(f"duty_correction: expected {v.shape[0]} finite numbers in (-1, 1)")
     return FitProblem(
         situations=situations, tau=float(tau), stride_target_m=jnp.asarray(stride),
         stride_tolerance=col(lambda t: t["stride_length"].values["relative_tolerance"]),
         stride_mask=jnp.asarray(np.asarray(situations.new_swing) & (v > 0.0)),
+        stride_correction=jnp.asarray(stride_correction),
         duty_low=col(lambda t: t["duty_factor"].values["low"]), duty_high=col(lambda t: t["duty_factor"].values["high"]),
-        duty_mask=jnp.asarray(froude) < duty_fr,
+        duty_mask=jnp.asarray(froude) < duty_fr, duty_correction=jnp.asarray(duty_correction),
         max_duty_slope=jnp.asarray(min(t["duty_factor_slope"].values["max_slope"] for t in per)),
         jerk_max=col(lambda t: t["swing_jerk"].values["maximum"]),
         curvature_max=col(lambda t: t["curvature_energy"].values["maximum"]),
@@ -130,8 +157,11 @@ def residuals(params, problem: FitProblem):
     w = jnp.exp(log_weights)
     timing = timing_vector(log_timing, s.timing0)
     m = expected_metrics(w, timing, s, problem.tau, clearance_cap_m=problem.clearance_min_m)
-    stride = (m["step_length_m"] / problem.stride_target_m - 1.0) / problem.stride_tolerance
-    duty = duty_factor(timing, s.speed, s.leg_height)
+    moving = s.speed > 0.0
+    frequency = stride_frequency(timing, s.speed, s.leg_height)
+    commanded = jnp.where(moving, s.speed / jnp.where(moving, frequency, 1.0), 0.0)
+    stride = (problem.stride_correction * commanded / problem.stride_target_m - 1.0) / problem.stride_tolerance
+    duty = duty_factor(timing, s.speed, s.leg_height) + problem.duty_correction
     width = problem.duty_high - problem.duty_low
     duty_out = (jax.nn.relu(problem.duty_low - duty) + jax.nn.relu(duty - problem.duty_high)) / width
     slope = jax.nn.relu(-timing[TIMING_FIELDS.index("duty_slope")] - problem.max_duty_slope)
