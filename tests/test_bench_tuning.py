@@ -12,7 +12,7 @@ import pytest
 from benchmarks import tuning_bench as tb
 
 TINY = dict(exact_frames=60, harvest_frames=15, max_situations=80, froude=(0.01, 0.02), exact_scenarios=("flat",),
-            fit_steps=3)
+            fit_steps=3, exact_characters=1)
 MAX_EVALS = 6
 PUBLIC = ("wall_s", "exact_evals", "exact_loss")
 
