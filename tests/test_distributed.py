@@ -3,9 +3,6 @@ mid-sweep costs only its tasks. The cluster listens on loopback only."""
 
 from __future__ import annotations
 
-import os
-import signal
-import time
 
 import pytest
 
@@ -26,27 +23,13 @@ def in_process(quick_tasks):
     return run_tasks(run_task, quick_tasks, workers=1)
 
 
-def test_a_worker_killed_mid_sweep_costs_only_its_tasks(quick_tasks, in_process):
+def test_a_worker_killed_mid_sweep_costs_only_its_tasks(quick_tasks, in_process, kill_a_busy_worker):
     from distributed import Client, LocalCluster
 
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
                       dashboard_address=None) as cluster, Client(cluster) as client:
-        killed = []
-
-        def kill_a_busy_worker(task, done):
-            if killed:
-                return
-            # Wait (bounded) until some worker is running a task, then kill its process.
-            for _ in range(200):
-                busy = [w for w, keys in client.processing().items() if keys]
-                if busy:
-                    pid = client.run(os.getpid, workers=[busy[0]])[busy[0]]
-                    os.kill(pid, signal.SIGKILL)
-                    killed.append(busy[0])
-                    return
-                time.sleep(0.05)
-
-        results = run_tasks(run_task, quick_tasks, cluster=cluster.scheduler_address, progress=kill_a_busy_worker)
+        kill, killed = kill_a_busy_worker(client)
+        results = run_tasks(run_task, quick_tasks, cluster=cluster.scheduler_address, progress=kill)
     assert killed, "no worker was busy: the sweep did not run on the cluster"
     assert len(results) == len(quick_tasks)
     assert [without_timings(r) for r in results] == [without_timings(r) for r in in_process]

@@ -5,19 +5,16 @@ killed mid-run. The clusters listen on loopback only."""
 from __future__ import annotations
 
 import dataclasses
-import os
-import signal
 import subprocess
 import sys
-import time
 
 import numba
 import numpy as np
 import pytest
 
+from footfall._distribute import task_runner
 from planner import GaitTiming, ScoringWeights
 from planner._harvest import Harvest, _harvest_batch, _pack, harvest_chunk, harvest_situations, harvest_tasks
-from footfall._distribute import task_runner
 from tuning._exact import ExactSetup, exact_metrics
 
 # Tiny runs: 2 characters so that some frames plan several feet (a cap can fall inside a frame).
@@ -145,7 +142,7 @@ def test_exact_metrics_on_local_workers_are_the_in_process_ones(runner):
         assert len(here["runs"]) == 4
 
 
-def test_a_worker_killed_mid_run_costs_only_its_tasks(runner):
+def test_a_worker_killed_mid_run_costs_only_its_tasks(runner, kill_a_busy_worker):
     from distributed import default_client
 
     # Enough tasks that some are still in flight on a worker when the first one finishes.
@@ -155,26 +152,13 @@ def test_a_worker_killed_mid_run_costs_only_its_tasks(runner):
     # task_runner's LocalCluster, whose nanny restarts the worker.
     client = default_client()
     assert client.scheduler.address.startswith("tcp://127.0.0.1:")
-    killed = []
-
-    def kill_a_busy_worker(task, done):
-        if killed:
-            return
-        # Wait (bounded) until some worker is running a task, then kill its process.
-        for _ in range(200):
-            busy = [w for w, keys in client.processing().items() if keys]
-            if busy:
-                pid = client.run(os.getpid, workers=[busy[0]])[busy[0]]
-                os.kill(pid, signal.SIGKILL)
-                killed.append(busy[0])
-                return
-            time.sleep(0.05)
+    kill, killed = kill_a_busy_worker(client)
 
     calls = []
 
     def map_and_kill(function, tasks, progress=None):
         calls.append(len(tasks))
-        return runner(function, tasks, progress=kill_a_busy_worker)
+        return runner(function, tasks, progress=kill)
 
     result = exact_metrics(setup, map_tasks=map_and_kill)
     assert calls == [12]
