@@ -10,9 +10,10 @@ on ``TuneConfig.exact_setup()``, the same targets), over the same parameters, fr
   round. Its result is the checkpoint's best (accepted) exact loss: the *target* (a line-search
   candidate the tune's guards refused may have had a lower one; it is counted, not used). The
   held-out evaluation and the Spearman harvest that end a tune measure the preset, they do not
-  optimise it: the tune runs without them (``evaluate=False``), so they are neither run, counted nor timed. The wall time includes the harvests and
-  the fits (with JAX tracing and compilation of the fit, which every ``footfall tune`` process
-  pays once).
+  optimise it: the tune runs without them (``evaluate=False``), so they are neither run, counted
+  nor timed. The wall time includes the harvests and the fits (with JAX tracing and compilation
+  of the fit, which every ``footfall tune`` process pays once). Both methods run in this process
+  (``workers=1``) on :data:`BENCH_SETUP`.
 * **cmaes** -- a seeded ``cma.CMAEvolutionStrategy`` on x = log of the 19 ``ScoringWeights`` and log
   of the 4 ``tuning._fit.FITTED_TIMING`` fields (the space the fit searches; the other timing fields
   stay at their defaults), x0 = log of the defaults, sigma0 = :data:`SIGMA0` (log space: a factor of

@@ -95,7 +95,8 @@ def run_main_job(scenario_name: str, out_dir, *, seed: int = 0, quick: bool = Fa
     report = build_report(out / "report", preset="quick" if quick else "default", scenarios=sweep, seed=seed,
                           recording=str(recording), workers=workers,
                           progress=lambda what, done, total: progress("report", f"{what} ({done}/{total})"))
-    summary["report"] = {"recommended_budget": report.get("recommended_budget"), "index": str(out / "report" / "index.html")}
+    summary["report"] = {"recommended_budget": report.get("recommended_budget"),
+                         "index": str(out / "report" / "index.html")}
     summary["seconds"]["report"] = time.perf_counter() - t0
 
     t0 = time.perf_counter()

@@ -129,7 +129,8 @@ def simulate_cmd(
     gait: Optional[str] = typer.Option(None, help="Gait name or .toml (default: the creature's)"),
     lod: str = typer.Option("off", help="Level of detail: on, zoomed or off"),
     seed: int = typer.Option(0, help="Seed (same seed, same recording)"),
-    preset: Optional[str] = typer.Option(None, help="Weight preset for this creature: a .json file or a shipped one by name (spider, ant, ...)"),
+    preset: Optional[str] = typer.Option(None, help="Weight preset for this creature: a .json file or a shipped "
+                                         "one by name (spider, ant, ...)"),
     record: Optional[str] = typer.Option(None, help="Save the recording (.npz)"),
     json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),
 ) -> None:
@@ -177,7 +178,7 @@ def run_cmd(
     out: str = typer.Option("out", "--out", help="Output folder"),
     seed: int = typer.Option(0, help="Seed of every step (same seed, same results; timings aside)"),
     quick: bool = typer.Option(False, "--quick", help="Short runs and a quick sweep (seconds; for tests)"),
-    workers: Optional[int] = typer.Option(None, help="Local worker processes of the report's sweep (default: one "
+    workers: Optional[int] = typer.Option(None, help="Local worker processes of the tune and the report (default: one "
                                           "per core; 1: in-process)"),
     json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),
 ) -> None:
@@ -227,7 +228,8 @@ def export_usd_cmd(
                                            "recording's)"),
     gait: Optional[str] = typer.Option(None, help="Gait name or .toml (default: the creature's)"),
     seed: Optional[int] = typer.Option(None, help="Seed (default 0; same seed, same animation)"),
-    preset: Optional[str] = typer.Option(None, help="Weight preset for this creature: a .json file or a shipped one by name (spider, ant, ...)"),
+    preset: Optional[str] = typer.Option(None, help="Weight preset for this creature: a .json file or a shipped "
+                                         "one by name (spider, ant, ...)"),
     recording: Optional[str] = typer.Option(None, help="Export this recording (.npz from simulate --record) "
                                             "instead of simulating"),
 ) -> None:

@@ -307,8 +307,8 @@ def exact_metrics(setup: ExactSetup, weights=None, timing=None, targets=None, ma
     return {
         "exact_loss": float(loss), "stride_rel_error": float(np.mean(np.abs(ratios - 1.0))),
         "stride_ratio": [float(x) for x in ratios], "stride_term": stride_term, "duty_term": duty_term,
-        "curvature_energy_mean": curvature, "curvature_energy_se": curvature_se, "curvature_term": curvature_term, "clearance_mean_m": clearance,
-        "clearance_term": clearance_term, "jerk_median": jerk, "collisions": collisions,
+        "curvature_energy_mean": curvature, "curvature_energy_se": curvature_se, "curvature_term": curvature_term,
+        "clearance_mean_m": clearance, "clearance_term": clearance_term, "jerk_median": jerk, "collisions": collisions,
         "finite": all(r["finite"] for r in runs), "plans": int(raw_all.shape[0]), "leg_height_m": h,
         "runs": per_run,
     }

@@ -18,10 +18,11 @@ Each outer round r (``rounds`` at most):
 3. **exact loss** (:mod:`tuning._exact`) along the fitted step: the parameters
    exp(log current + alpha (log fitted - log current)) for alpha in :data:`LINE_SEARCH`,
    the first accepted one kept (a backtracking line search on the exact loss). A candidate is
-   accepted if its exact loss is lower than the best so far, its stride error not higher, it has no more
-   collisions than the default weights, its mean curvature energy is not above the
-   default's by more than its sampling noise (:func:`curvature_limit`) and its median jerk not above the default's by
-   more than :data:`tuning._exact.JERK_GUARD` (the jerk target itself cannot be met:
+   accepted if its exact loss is lower than the best so far, its stride error not higher, it
+   has no more collisions than the default weights, its mean curvature energy is not above
+   the default's by more than its sampling noise (:func:`curvature_limit`) and its median
+   jerk not above the default's by more than :data:`tuning._exact.JERK_GUARD` (the jerk
+   target itself cannot be met:
    see :mod:`tuning._exact`; the fit gives the jerk block zero weight). The loop stops
    at the first round that does not improve (or after ``rounds``).
 
@@ -35,7 +36,10 @@ Finally the best parameters are evaluated on **held-out** runs (scenarios and se
 the fit did not see), and ``spearman_proxy_exact`` -- Spearman's rank correlation
 between the JAX proxy's couple scores (hard scores, the tau -> 0 limit of the
 proxy) and the runtime's exact couple scores over every valid couple of a fresh
-harvest under the tuned parameters -- is computed. The preset (``planner._presets``
+harvest under the tuned parameters -- is computed. It is 1 unless the JAX scoring and the
+runtime's drift apart: the proxy relaxes the *selection* (softmax at temperature tau) and,
+for the stride and the duty factor, the exact planner's response (space mapping); the couple
+scores it ranks are the runtime's own function of the weights. The preset (``planner._presets``
 schema) carries all of it in its provenance; the wall time is not in the preset (a
 resumed run writes the same bytes).
 """
