@@ -119,10 +119,10 @@ def make_problem(situations: Situations, creature_names, targets, tau: float, je
     if stride_correction is None:
         stride_correction = np.ones(v.shape)
     stride_correction = np.asarray(stride_correction, dtype=np.float64)
-    if stride_correction.shape != v.shape or not (np.isfinite(stride_correction).all() and (stride_correction > 0).all()):
+    if stride_correction.shape != v.shape or not (np.isfinite(stride_correction) & (stride_correction > 0)).all():
         raise ValueError(f"stride_correction: expected {v.shape[0]} positive finite numbers")
     duty_correction = np.zeros(v.shape) if duty_correction is None else np.asarray(duty_correction, dtype=np.float64)
-    if duty_correction.shape != v.shape or not (np.isfinite(duty_correction).all() and (abs(duty_correction) < 1).all()):
+    if duty_correction.shape != v.shape or not (np.isfinite(duty_correction) & (abs(duty_correction) < 1)).all():
         raise ValueError(f"duty_correction: expected {v.shape[0]} finite numbers in (-1, 1)")
     return FitProblem(
         situations=situations, tau=float(tau), stride_target_m=jnp.asarray(stride),
