@@ -32,6 +32,22 @@ def unwritable_reason(folder: str | Path) -> str | None:
     return None
 
 
+def make_folder(folder: str | Path, file, field: str) -> Path:
+    """Create ``folder`` (and its parents) for outputs, or raise a one-line :class:`InputError`
+    naming ``file`` and ``field`` (:func:`unwritable_reason` first: nothing is created then)."""
+    from footfall._errors import InputError
+
+    folder = Path(folder)
+    reason = unwritable_reason(folder)
+    if reason:
+        raise InputError(file, field, reason)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise InputError(file, field, f"cannot create {folder}: {e.strerror or e}") from None
+    return folder
+
+
 @contextmanager
 def atomic_path(target: str | Path, suffix: str = "") -> Iterator[Path]:
     """Yield a temporary path next to ``target``; rename it over ``target`` on success.

@@ -20,7 +20,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from footfall._atomic import unwritable_reason, write_text_atomic
+from footfall._atomic import make_folder, write_text_atomic
 from footfall._errors import InputError
 
 STEPS = ("simulate", "tune", "report", "export")
@@ -36,14 +36,7 @@ def _writable_folder(out: Path) -> Path:
     out = Path(out).absolute()
     if out.exists() and not out.is_dir():
         raise InputError(out, "--out", "exists and is not a folder")
-    reason = unwritable_reason(out)
-    if reason:
-        raise InputError(out, "--out", reason)
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as e:
-        raise InputError(out, "--out", f"cannot create the folder: {e.strerror or e}") from None
-    return out
+    return make_folder(out, out, "--out")
 
 
 def run_main_job(scenario_name: str, out_dir, *, seed: int = 0, quick: bool = False, workers: int | None = None,

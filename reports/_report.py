@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from footfall._atomic import unwritable_reason
+from footfall._atomic import make_folder
 from footfall._errors import InputError
 from footfall._distribute import check_workers, run_tasks
 from reports import _html, _pareto, _plots, _sweep
@@ -45,13 +45,7 @@ def _writable_out(out: Path) -> None:
         if not ok:
             raise InputError("argument", "--out", f"{out} is a folder that is not a footfall report; "
                              "choose a new or empty folder")
-    reason = unwritable_reason(out.parent)
-    if reason:
-        raise InputError("argument", "--out", reason)
-    try:
-        out.parent.mkdir(parents=True, exist_ok=True)
-    except OSError as e:
-        raise InputError("argument", "--out", f"cannot create {out.parent}: {e.strerror or e}") from None
+    make_folder(out.parent, "argument", "--out")
 
 
 def _make_temp(out: Path) -> Path:

@@ -56,7 +56,7 @@ from pathlib import Path
 
 import numpy as np
 
-from footfall._atomic import write_text_atomic
+from footfall._atomic import make_folder, write_text_atomic
 from footfall._errors import InputError
 from tuning._exact import JERK_GUARD, ExactSetup, exact_metrics, speeds_for
 
@@ -165,20 +165,12 @@ def check_output(path: str | Path) -> Path:
     """Refuse an output that cannot be written, before any work."""
     import os
 
-    from footfall._atomic import unwritable_reason
-
     path = Path(path)
     if path.suffix != ".json":
         raise InputError("argument", "--out", f"expected a .json path, got {str(path)!r}")
     if path.is_dir():
         raise InputError("argument", "--out", f"{path} is a directory")
-    reason = unwritable_reason(path.parent)
-    if reason:
-        raise InputError("argument", "--out", reason)
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-    except OSError as e:
-        raise InputError("argument", "--out", f"cannot write to {path.parent}: {e.strerror or e}") from None
+    make_folder(path.parent, "argument", "--out")
     if path.exists() and not os.access(path, os.W_OK):
         raise InputError("argument", "--out", f"cannot write {path} (no permission)")
     return path
