@@ -59,6 +59,14 @@ class ControllerConfig:
     swinging foot re-plans (§3.2); ``feedback_threshold`` (fraction of the rest
     radius) is when the mean offset between preferred and chosen footprints is
     'significant' and moves the pelvis, at ``feedback_gain`` per second.
+
+    Sustainable speed: a body held because a stance leg cannot follow (the legs cannot take
+    the strides this speed asks for) lowers the character's speed limit to ``hold_backoff``
+    times the speed it was held at; the limit grows back by ``limit_recovery`` times the
+    desired speed per second. Without it a character asked for more than its legs can do
+    walks stop-and-go at full speed, and its strides are those of the speed it was asked
+    for, not of the speed it keeps (issue 4: realised stride vs speed); with it, it settles
+    just under the fastest walk its legs sustain, with the gait of that speed.
     """
 
     turn_rate: float = 1.5  # rad/s
@@ -81,6 +89,14 @@ class ControllerConfig:
     ik_iterations: int = 16  # CCD sweeps per stance leg and frame, restarts included (warm started)
     ik_swing_iterations: int = 4  # CCD sweeps per swinging leg and frame, no restarts
     ik_restarts: int = 2  # restarts of a stalled stance leg (each scans poses: the costly part)
+    hold_backoff: float = 0.85  # speed limit after a hold, x the speed held at
+    limit_recovery: float = 0.1  # growth of the speed limit, x desired speed per second
+
+    def __post_init__(self) -> None:
+        if not 0.0 < self.hold_backoff <= 1.0:
+            raise ValueError(f"ControllerConfig.hold_backoff: expected a number in (0, 1], got {self.hold_backoff!r}")
+        if not self.limit_recovery > 0.0:
+            raise ValueError(f"ControllerConfig.limit_recovery: expected a number > 0, got {self.limit_recovery!r}")
 
 
 def _rot_xz(heading, forward, lateral):
@@ -164,6 +180,7 @@ class CrowdState:
     hull: np.ndarray  # (C,)
     pelvis_rise: np.ndarray  # (C,) m, change of pelvis height over the last frame
     body_held: np.ndarray  # (C,) bool: a stance foot could not follow and could not step: wait a frame
+    speed_limit: np.ndarray  # (C,) m/s, the sustainable speed learnt from holds (inf: never held)
     last_move: np.ndarray  # (C, 2) m, the pelvis's move on the ground in the last steer stage
     cannot_follow: np.ndarray  # (C, L) bool: the last look-ahead found the leg cannot follow its stance foot
     counters: dict = field(default_factory=dict)
@@ -229,6 +246,10 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
     turn = _wrap(desired - state.heading)
     state.heading = _wrap(state.heading + np.clip(turn, -ctl.turn_rate * dt, ctl.turn_rate * dt))
     v_des = np.where(arrived, 0.0, state.desired_speed * np.maximum(0.3, np.cos(np.clip(turn, -np.pi / 2, np.pi / 2))))
+    # The speed limit learnt from holds grows back (ControllerConfig: sustainable speed).
+    free = ~state.body_held
+    state.speed_limit[free] += ctl.limit_recovery * state.desired_speed[free] * dt
+    v_des = np.minimum(v_des, state.speed_limit)
     state.speed = state.speed + np.clip(v_des - state.speed, -ctl.acceleration * dt, ctl.acceleration * dt)
     # The body never outruns its legs: a character with a stance foot its leg cannot follow,
     # and no room to lift it, waits.
@@ -353,6 +374,7 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips) -> 
     held = (cannot_follow & (kinds == 0)).any(axis=1)
     # Held from this frame on: take back this frame's move (the pelvis pose stays too).
     newly = held & ~state.body_held
+    state.speed_limit[newly] = np.minimum(state.speed_limit[newly], ctl.hold_backoff * state.speed[newly])
     state.pelvis[newly, 0] -= state.last_move[newly, 0]
     state.pelvis[newly, 2] -= state.last_move[newly, 1]
     state.body_held = held
@@ -652,7 +674,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         plan_heading=np.repeat(headings[:, None], L, axis=1), plan_speed=np.zeros((n, L)),
         feet_spacing=np.ones(n), plan_spacing=np.ones((n, L)), foot_yaws=yaws,
         gaits=init_gaits([gait] * n, n, rng.uniform(0.0, 1.0, n)), angles=angles, residual=np.zeros((n, L)),
-        ik_on=np.zeros(n, np.bool_), fk_feet=feet.copy(), hull=np.zeros(n), pelvis_rise=np.zeros(n), body_held=np.zeros(n, np.bool_), last_move=np.zeros((n, 2)), cannot_follow=np.zeros((n, L), np.bool_),
+        ik_on=np.zeros(n, np.bool_), fk_feet=feet.copy(), hull=np.zeros(n), pelvis_rise=np.zeros(n), body_held=np.zeros(n, np.bool_), speed_limit=np.full(n, np.inf), last_move=np.zeros((n, 2)), cannot_follow=np.zeros((n, L), np.bool_),
         counters={k: 0 for k in ("steps", "plans", "holds", "replans", "forbidden_footprints", "cells_expanded",
                                  "couples_evaluated")})
     stage_pelvis(model, state)

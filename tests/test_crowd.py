@@ -1,6 +1,7 @@
 """Crowd simulation properties over >= 200 seeded runs of the built-in scenarios and creatures."""
 
 import json
+import math
 import subprocess
 import sys
 
@@ -166,3 +167,47 @@ def test_a_feet_spacing_change_replans_swinging_feet_and_narrows_the_stance():
     for _ in range(40):
         step(model, state)
     assert spread() < 0.9 * before
+
+
+def _walk_too_fast(controller, frames=150, warmup=30):
+    """An ant on flat ground asked for Fr = 0.32 (0.40 m/s): more than its legs sustain.
+    (holds, speed_limit at the end, realised speed, stride / target at the realised speed)."""
+    from planner._simulation import realised_strides
+    from planner._timing import GRAVITY, hip_height
+    from tuning._targets import load_targets
+
+    scenario, creature = load_scenario("flat"), load_creature("ant")
+    h = hip_height(creature)
+    model, state = init_crowd(scenario, creature, load_gait(default_gait_name("ant"), creature), n_characters=2,
+                              seed=0, lod_mode="off", raster=_raster(scenario, creature), controller=controller)
+    state.desired_speed[:] = math.sqrt(0.32 * GRAVITY * h)
+    feet, stance, pelvis, holds = [], [], [], [0]
+
+    def after(k):
+        holds[0] += int(state.body_held.sum())
+        if k > warmup:
+            feet.append(state.feet.copy())
+            stance.append(state.in_stance.copy())
+            pelvis.append(state.pelvis.copy())
+
+    simulate(model, state, frames, progress=after)
+    v, stride = realised_strides(np.array(feet), np.array(stance), np.array(pelvis), model.dt)
+    target = load_targets(creatures=("ant",))["ant"].stride_length_m(v)
+    return holds[0], state.speed_limit.copy(), float(v.mean()), float(stride.mean() / target.mean())
+
+
+def test_a_character_asked_for_more_than_its_legs_sustain_slows_down_instead_of_stop_and_go():
+    """Holds (a stance leg that cannot follow) lower the character's speed limit, so it walks with the
+    gait of the speed it keeps. Without that (a hold forgotten at once: the old controller) the body
+    waits and runs on at full speed, and its strides are those of the speed it was asked for."""
+    from planner._crowd import ControllerConfig
+
+    holds, limit, v, ratio = _walk_too_fast(ControllerConfig())
+    stop_and_go = ControllerConfig(hold_backoff=1.0, limit_recovery=1e9)
+    holds_old, _, v_old, ratio_old = _walk_too_fast(stop_and_go)
+    assert holds_old > 0  # the speed is beyond what the legs sustain
+    assert holds > 0 and np.all(limit < 0.40)  # held, and the limit learnt from it
+    # Strides against the target at the realised speed, 2.3 h Fr^0.3: the stop-and-go walk's are
+    # nearer those of the desired speed, up to (v_desired / v)^0.6 longer.
+    assert ratio_old > 1.0
+    assert abs(ratio - 1.0) < abs(ratio_old - 1.0)

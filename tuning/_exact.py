@@ -11,8 +11,9 @@ v = sqrt(Fr g h) (h: ``planner._timing.hip_height``), the same dynamic
 similarity for every creature (:func:`sweep_froude`): from where the target stride is
 :data:`STRIDE_MIN_CELLS` planner cells (shorter strides are resolution-limited: footprints
 are cell centres) up to 2.8 times that Froude number. Above about Fr = 0.08 a spider's
-stance legs cannot follow and the body waits: its realised speed saturates, which is why
-strides are compared with the target at the realised speed.
+stance legs cannot follow: the body waits, and the controller lowers the character's speed
+limit (``planner._crowd.ControllerConfig``: sustainable speed). Its realised speed saturates,
+which is why strides are compared with the target at the realised speed.
 The first ``warmup`` frames (start-up, acceleration, gait transition) are not
 measured. Everything is deterministic for a seed (the crowd is).
 
