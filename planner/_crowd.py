@@ -10,7 +10,8 @@ characters.
 Stages of a frame (timed one by one):
 1. ``steer``: pelvis speed and heading toward the next waypoint, pushed away from
    forbidden boxes ahead, moved on the ground plane; feet feedback (§3.2, Fig. 7).
-2. ``gait``: the needle advances; feet whose swing sector starts enter swing (§3.3).
+2. ``gait``: the needle advances; feet whose swing sector starts enter swing (§3.3); a foot
+   still in the air then keeps its turn for when it lands.
 3. ``swing``: swinging feet move along their trajectories at constant speed; landings.
 4. ``requests``: feet to plan: new swings; swinging feet to re-plan (turn, speed
    change, trajectory invalidated by a moving box); stance feet out of reach or
@@ -66,7 +67,9 @@ class ControllerConfig:
     desired speed per second. Without it a character asked for more than its legs can do
     walks stop-and-go at full speed, and its strides are those of the speed it was asked
     for, not of the speed it keeps (issue 4: realised stride vs speed); with it, it settles
-    just under the fastest walk its legs sustain, with the gait of that speed.
+    just under the fastest walk its legs sustain, with the gait of that speed. A step begun
+    while the body stands takes the swing time of the walk it resumes (``stage_plan``), and a
+    foot in the air when its sector starts keeps its turn (``stage_gait``).
     """
 
     turn_rate: float = 1.5  # rad/s
@@ -163,6 +166,7 @@ class CrowdState:
     feet: np.ndarray  # (C, L, 3)
     in_stance: np.ndarray  # (C, L) bool
     wants_swing: np.ndarray  # (C, L) bool: the gait asked for a swing not yet planned
+    sector_missed: np.ndarray  # (C, L) bool: the needle entered the foot's sector while it was in the air
     swing_t: np.ndarray
     swing_T: np.ndarray
     trajectories: np.ndarray  # (C, L, K, 3)
@@ -274,7 +278,16 @@ def stage_gait(model: CrowdModel, state: CrowdState):
     from planner._gait import advance, set_speed
 
     frequency = set_speed(state.gaits, model.timing, state.speed, model.leg_height)
+    in_air = ~state.in_stance
     enter, fraction = advance(state.gaits, frequency, model.dt, state.in_stance)
+    # A foot still in the air when the needle enters its sector (a forced step, a late landing)
+    # keeps its turn: it lifts again on landing while the sector lasts. Dropping the turn made it
+    # skip a whole cycle: a stride of two cycles, and a foot left behind that must be forced again.
+    g = state.gaits
+    phase = np.mod(g.needle[:, None] - g.disk_start, 1.0)  # the needle past each sector's start
+    sweep = (frequency * model.dt)[:, None]
+    state.sector_missed |= in_air & ((phase < sweep) | (sweep >= 1.0))
+    state.sector_missed &= phase < g.disk_duration  # the turn lapses with its sector
     return frequency, enter, fraction
 
 
@@ -337,7 +350,8 @@ def _stance_unreachable_ahead(model: CrowdModel, state: CrowdState, hips) -> np.
 def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips) -> np.ndarray:
     """(C, L) int8 request kinds: 0 none, 1 new swing, 2 forced step, 3 re-plan."""
     ctl = model.controller
-    state.wants_swing |= enter & state.in_stance
+    state.wants_swing |= (enter | state.sector_missed) & state.in_stance
+    state.sector_missed &= ~state.in_stance
     kinds = np.zeros(state.in_stance.shape, dtype=np.int8)
     kinds[state.wants_swing & state.in_stance] = 1
     far = np.hypot(state.feet[..., 0] - hips[..., 0], state.feet[..., 2] - hips[..., 2]) > _reach_xz(model)[None, :]
@@ -428,7 +442,18 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     n_legs = model.n_legs
     map_of = np.full(state.pelvis.shape[0], -1, np.int64)
     map_of[chars] = np.arange(chars.size)
-    freq = np.maximum(frequency[cs], 1e-3)
+    freq = frequency[cs]
+    still = freq <= 0.0
+    if still.any():
+        # A body standing (a hold, the first frame) has no tempo: its steps take the swing time of
+        # the walk it will resume. The 1e-3 Hz floor alone gave them the 1 s cap: a foot in the air
+        # for several cycles, re-planned again and again while the body picked up speed.
+        from planner._timing import stride_frequency
+
+        resume = np.minimum(state.desired_speed[cs][still], state.speed_limit[cs][still])
+        freq = freq.copy()
+        freq[still] = stride_frequency(model.timing, resume, model.leg_height)
+    freq = np.maximum(freq, 1e-3)
     durations = np.asarray(state.gaits.disk_duration)[cs, ls]
     new = kinds[cs, ls] != 3
     t_swing = np.where(new, np.minimum(durations / freq, 1.0),
@@ -669,7 +694,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         t=0.0, frame=0, pelvis=pelvis, heading=headings.copy(), pitch=np.zeros(n), roll=np.zeros(n),
         speed=np.zeros(n), desired_speed=np.full(n, speed), route=routes, route_index=np.zeros(n, np.int64),
         feedback=np.zeros((n, 2)), feet=feet, in_stance=np.ones((n, L), np.bool_),
-        wants_swing=np.zeros((n, L), np.bool_), swing_t=np.zeros((n, L)), swing_T=np.zeros((n, L)),
+        wants_swing=np.zeros((n, L), np.bool_), sector_missed=np.zeros((n, L), np.bool_), swing_t=np.zeros((n, L)), swing_T=np.zeros((n, L)),
         trajectories=np.repeat(feet[:, :, None, :], K, axis=2), swing_target=feet.copy(),
         plan_heading=np.repeat(headings[:, None], L, axis=1), plan_speed=np.zeros((n, L)),
         feet_spacing=np.ones(n), plan_spacing=np.ones((n, L)), foot_yaws=yaws,

@@ -169,19 +169,20 @@ def test_a_feet_spacing_change_replans_swinging_feet_and_narrows_the_stance():
     assert spread() < 0.9 * before
 
 
-def _walk_too_fast(controller, frames=150, warmup=30):
-    """An ant on flat ground asked for Fr = 0.32 (0.40 m/s): more than its legs sustain.
-    (holds, speed_limit at the end, realised speed, stride / target at the realised speed)."""
+def _walk_too_fast(controller, creature_name="ant", froude=0.32, frames=150, warmup=30):
+    """Two characters on flat ground asked for more than their legs sustain (the ant at Fr = 0.32,
+    0.40 m/s). Returns (held character-frames, speed_limit at the end, the planned times of the swings
+    begun after the warm-up, stride / target at the realised speed)."""
     from planner._simulation import realised_strides
     from planner._timing import GRAVITY, hip_height
     from tuning._targets import load_targets
 
-    scenario, creature = load_scenario("flat"), load_creature("ant")
-    h = hip_height(creature)
-    model, state = init_crowd(scenario, creature, load_gait(default_gait_name("ant"), creature), n_characters=2,
-                              seed=0, lod_mode="off", raster=_raster(scenario, creature), controller=controller)
-    state.desired_speed[:] = math.sqrt(0.32 * GRAVITY * h)
-    feet, stance, pelvis, holds = [], [], [], [0]
+    scenario, creature = load_scenario("flat"), load_creature(creature_name)
+    model, state = init_crowd(scenario, creature, load_gait(default_gait_name(creature_name), creature),
+                              n_characters=2, seed=0, lod_mode="off", raster=_raster(scenario, creature),
+                              controller=controller)
+    state.desired_speed[:] = math.sqrt(froude * GRAVITY * hip_height(creature))
+    feet, stance, pelvis, swing_times, holds = [], [], [], [], [0]
 
     def after(k):
         holds[0] += int(state.body_held.sum())
@@ -189,25 +190,67 @@ def _walk_too_fast(controller, frames=150, warmup=30):
             feet.append(state.feet.copy())
             stance.append(state.in_stance.copy())
             pelvis.append(state.pelvis.copy())
+            begun = ~state.in_stance & (state.swing_t == 0.0)
+            swing_times.extend(state.swing_T[begun].tolist())
 
     simulate(model, state, frames, progress=after)
     v, stride = realised_strides(np.array(feet), np.array(stance), np.array(pelvis), model.dt)
-    target = load_targets(creatures=("ant",))["ant"].stride_length_m(v)
-    return holds[0], state.speed_limit.copy(), float(v.mean()), float(stride.mean() / target.mean())
+    target = load_targets(creatures=(creature_name,))[creature_name].stride_length_m(v)
+    return holds[0], state.speed_limit.copy(), np.array(swing_times), float(stride.mean() / target.mean()), model
 
 
 def test_a_character_asked_for_more_than_its_legs_sustain_slows_down_instead_of_stop_and_go():
     """Holds (a stance leg that cannot follow) lower the character's speed limit, so it walks with the
     gait of the speed it keeps. Without that (a hold forgotten at once: the old controller) the body
-    waits and runs on at full speed, and its strides are those of the speed it was asked for."""
+    waits and runs on at full speed, and its strides are nearer those of the speed it was asked for."""
     from planner._crowd import ControllerConfig
 
-    holds, limit, v, ratio = _walk_too_fast(ControllerConfig())
+    holds, limit, _, ratio, model = _walk_too_fast(ControllerConfig(), "spider", froude=0.1)
     stop_and_go = ControllerConfig(hold_backoff=1.0, limit_recovery=1e9)
-    holds_old, _, v_old, ratio_old = _walk_too_fast(stop_and_go)
+    holds_old, _, _, ratio_old, _ = _walk_too_fast(stop_and_go, "spider", froude=0.1)
+    desired = math.sqrt(0.1 * 9.81 * model.leg_height)
     assert holds_old > 0  # the speed is beyond what the legs sustain
-    assert holds > 0 and np.all(limit < 0.40)  # held, and the limit learnt from it
-    # Strides against the target at the realised speed, 2.3 h Fr^0.3: the stop-and-go walk's are
-    # nearer those of the desired speed, up to (v_desired / v)^0.6 longer.
+    assert holds > 0 and np.all(limit < desired)  # held, and the limit learnt from it
+    # Strides against the target at the realised speed, 2.3 h Fr^0.3.
     assert ratio_old > 1.0
     assert abs(ratio - 1.0) < abs(ratio_old - 1.0)
+
+
+def test_steps_begun_while_the_body_stands_take_the_swing_time_of_its_walk():
+    """A forced step planned during a hold (speed 0, so no tempo) swings as fast as the walk the body
+    resumes, not for the 1 s cap: no swing after the warm-up lasts even one stride at half the
+    desired speed (the ant's cycle there is 0.27 s)."""
+    from planner._crowd import ControllerConfig
+    from planner._timing import stride_frequency
+
+    holds, _, swing_times, ratio, model = _walk_too_fast(ControllerConfig())
+    assert holds > 0 and swing_times.size > 100
+    half = 0.5 * math.sqrt(0.32 * 9.81 * model.leg_height)
+    assert swing_times.max() < 1.0 / stride_frequency(model.timing, half, model.leg_height)
+    assert abs(ratio - 1.0) < 0.05  # the strides of the speed it keeps (stop-and-go: 9 % long)
+
+
+def test_a_foot_in_the_air_when_its_sector_starts_lifts_again_on_landing():
+    """The gait's turn is not lost because a foot was still swinging (a forced step, a late
+    landing) when the needle entered its sector: the foot lifts again as soon as it lands, while
+    the sector lasts. Losing it made the foot skip a whole cycle."""
+    from planner._crowd import step
+
+    scenario, creature = load_scenario("flat"), load_creature("spider")
+    model, state = init_crowd(scenario, creature, load_gait(default_gait_name("spider"), creature), n_characters=1,
+                              seed=0, lod_mode="off", raster=_raster(scenario, creature))
+    for _ in range(20):
+        step(model, state)
+    g = state.gaits
+    leg = int(np.flatnonzero(state.in_stance[0] & ~state.wants_swing[0])[0])
+    # The foot swings in place and lands in the second frame from now; the needle enters its
+    # sector in the first (a 0.01 cycle sweep needs only 0.3 Hz).
+    state.in_stance[0, leg] = False
+    state.trajectories[0, leg] = state.feet[0, leg]
+    state.swing_t[0, leg], state.swing_T[0, leg] = 0.0, 1.5 * model.dt
+    g.needle[0] = (g.disk_start[0, leg] - 0.01) % 1.0
+    step(model, state)
+    assert not state.in_stance[0, leg] and state.sector_missed[0, leg]
+    step(model, state)  # lands, and lifts again at once
+    assert not state.in_stance[0, leg] and state.swing_t[0, leg] == 0.0
+    assert not state.sector_missed[0, leg]

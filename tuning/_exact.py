@@ -278,7 +278,10 @@ def exact_metrics(setup: ExactSetup, weights=None, timing=None, targets=None, ma
         if r["froude"] < duty_t["froude_max"]:
             out = (max(0.0, duty_t["low"] - duty) + max(0.0, duty - duty_t["high"])) / (duty_t["high"] - duty_t["low"])
         duty_out.append(out)
-        per_run.append({"scenario": r["scenario"], "seed": r["seed"], "froude": r["froude"],
+        # This run's share of the loss's per-run terms (tuning._tune compares candidates run by run).
+        run_loss = 0.5 * ((0.0 if math.isnan(ratio) else ((ratio - 1.0) / stride_t["relative_tolerance"]) ** 2)
+                          + out * out)
+        per_run.append({"scenario": r["scenario"], "seed": r["seed"], "froude": r["froude"], "run_loss": run_loss,
                         "desired_speed": r["desired_speed"],
                         "realised_speed": float(np.mean(r["speed"])) if r["speed"].size else 0.0,
                         "strides": int(r["stride"].size), "stride_ratio": None if math.isnan(ratio) else ratio,

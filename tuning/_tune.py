@@ -18,7 +18,8 @@ Each outer round r (``rounds`` at most):
 3. **exact loss** (:mod:`tuning._exact`) along the fitted step: the parameters
    exp(log current + alpha (log fitted - log current)) for alpha in :data:`LINE_SEARCH`,
    the first accepted one kept (a backtracking line search on the exact loss). A candidate is
-   accepted if its exact loss is lower than the best so far, its stride error not higher, it
+   accepted if its exact loss is lower than the best so far, by more than the runs' noise
+   (:func:`paired_gain`, :data:`GAIN_NOISE_SE`), its stride error not higher, it
    has no more collisions than the default weights, its mean curvature energy is not above
    the default's by more than its sampling noise (:func:`curvature_limit`) and its median
    jerk not above the default's by more than :data:`tuning._exact.JERK_GUARD` (the jerk
@@ -61,13 +62,19 @@ from footfall._errors import InputError
 from tuning._exact import JERK_GUARD, ExactSetup, exact_metrics, speeds_for
 
 CHECKPOINT_FORMAT = "footfall-tune-checkpoint"
-CHECKPOINT_VERSION = 1
+CHECKPOINT_VERSION = 2
 CURVATURE_SLACK = 1e-9
 """Absolute slack on the mean curvature energy (straight paths have E ~ 1e-27)."""
 CURVATURE_NOISE_SE = 2.0
 """A candidate's mean curvature energy may exceed the default weights' by at most this many standard
 errors of the difference: the mean is carried by a few detours (Poisson-like), and the runs are
 chaotic in the parameters, so a strict comparison refused candidates on sampling noise alone."""
+GAIN_NOISE_SE = 2.0
+"""Default of ``TuneConfig.gain_noise_se``: a candidate must lower the per-run loss terms of the best
+so far by at least this many standard errors of the paired per-run differences (:func:`paired_gain`).
+The runs are chaotic in the parameters: any change reshuffles every later footstep and moves each
+run's stride by a few per cent, so a lower mean alone was often noise, and such presets lost on the
+held-out runs."""
 CORRECTION_RANGE = (0.5, 2.0)
 DUTY_CORRECTION_RANGE = (-0.3, 0.3)
 LINE_SEARCH = (1.0, 0.5, 0.25)
@@ -111,6 +118,9 @@ class TuneConfig:
     holdout_scenarios: tuple[str, ...] = ("stairs", "mixed")
     holdout_seeds: tuple[int, ...] = (101, 102)
     holdout_characters: int = 2
+    # Acceptance (module doc, step 3): 0 accepts any lower exact loss (``footfall bench tuning``:
+    # the optimisers compared on the loss alone, as CMA-ES is).
+    gain_noise_se: float = GAIN_NOISE_SE
 
     def __post_init__(self) -> None:
         for name in ("rounds", "seed", "harvest_frames", "harvest_characters", "max_situations", "fit_steps",
@@ -122,6 +132,9 @@ class TuneConfig:
             raise InputError("argument", "--rounds", f"expected an integer >= 1, got {self.rounds}")
         if self.seed < 0:
             raise InputError("argument", "--seed", f"expected an integer >= 0, got {self.seed}")
+        if isinstance(self.gain_noise_se, bool) or not isinstance(self.gain_noise_se, (int, float)) \
+                or not self.gain_noise_se >= 0.0:
+            raise InputError("argument", "gain_noise_se", f"expected a number >= 0, got {self.gain_noise_se!r}")
         if not self.tau > 0.0:
             raise InputError("argument", "tau", f"expected > 0, got {self.tau}")
 
@@ -407,7 +420,18 @@ def curvature_limit(default: dict, candidate: dict) -> float:
     return default["curvature_energy_mean"] + CURVATURE_NOISE_SE * se + CURVATURE_SLACK
 
 
-def _accept(candidate: dict, best: dict, default: dict) -> tuple[bool, str]:
+def paired_gain(best: dict, candidate: dict) -> tuple[float, float]:
+    """(mean, standard error) over the runs of best's ``run_loss`` - the candidate's: the same runs
+    (scenario, seed, speed) in the same order, with other parameters."""
+    a = np.array([r["run_loss"] for r in best["runs"]], dtype=np.float64)
+    b = np.array([r["run_loss"] for r in candidate["runs"]], dtype=np.float64)
+    if a.shape != b.shape or a.size < 2:
+        raise ValueError("paired_gain: expected the same runs (at least 2) in both")
+    d = a - b
+    return float(d.mean()), float(d.std(ddof=1) / math.sqrt(d.size))
+
+
+def _accept(candidate: dict, best: dict, default: dict, gain_noise_se: float = GAIN_NOISE_SE) -> tuple[bool, str]:
     if not candidate["finite"]:
         return False, "non-finite run"
     if candidate["collisions"] > default["collisions"]:
@@ -420,6 +444,10 @@ def _accept(candidate: dict, best: dict, default: dict) -> tuple[bool, str]:
         return False, "exact loss did not improve"
     if candidate["stride_rel_error"] > best["stride_rel_error"]:
         return False, "stride error rose (the exact loss fell through another term)"
+    if gain_noise_se > 0.0:
+        gain, se = paired_gain(best, candidate)
+        if gain < gain_noise_se * se:
+            return False, f"gain within the runs' noise ({gain:.3g} < {gain_noise_se:g} x SE {se:.3g})"
     return True, "improved"
 
 
@@ -490,7 +518,7 @@ def _tune(config: TuneConfig, out, resume, progress, stop_after, write, evaluate
         for alpha in LINE_SEARCH:
             params = _towards(state["current"], fitted, alpha)
             candidate = exact_metrics(setup, *_objects(params), targets=targets, map_tasks=map_tasks)
-            accepted, why = _accept(candidate, state["best"]["exact"], state["default_exact"])
+            accepted, why = _accept(candidate, state["best"]["exact"], state["default_exact"], config.gain_noise_se)
             tried.append({"alpha": alpha, "exact_loss": candidate["exact_loss"],
                           "stride_rel_error": candidate["stride_rel_error"], "decision": why})
             if accepted:
