@@ -219,3 +219,6 @@ def test_a_candidate_must_beat_the_best_by_more_than_the_runs_noise():
     assert not accepted and "noise" in why
     with pytest.raises(ValueError, match="same runs"):
         paired_gain(best, _metrics([1.0, 2.0], 0.5))
+    # Guards off (footfall bench tuning): a lower exact loss alone is enough.
+    assert _accept(lucky, best, best, guards=False) == (True, "improved")
+    assert _accept(_metrics([1.0, 2.0, 3.0], 1.0), best, best, guards=False)[0] is False

@@ -24,8 +24,9 @@ Each outer round r (``rounds`` at most):
    the default's by more than its sampling noise (:func:`curvature_limit`) and its median
    jerk not above the default's by more than :data:`tuning._exact.JERK_GUARD` (the jerk
    target itself cannot be met:
-   see :mod:`tuning._exact`; the fit gives the jerk block zero weight). The loop stops
-   at the first round that does not improve (or after ``rounds``).
+   see :mod:`tuning._exact`; the fit gives the jerk block zero weight). With
+   ``TuneConfig.guards`` false (``footfall bench tuning``) a lower exact loss alone is enough.
+   The loop stops at the first round that does not improve (or after ``rounds``).
 
 After every round a checkpoint (JSON, written atomically) holds the configuration,
 the round, the current and best parameters (float64 written with ``repr``: exact
@@ -118,9 +119,16 @@ class TuneConfig:
     holdout_scenarios: tuple[str, ...] = ("stairs", "mixed")
     holdout_seeds: tuple[int, ...] = (101, 102)
     holdout_characters: int = 2
-    # Acceptance (module doc, step 3): 0 accepts any lower exact loss (``footfall bench tuning``:
-    # the optimisers compared on the loss alone, as CMA-ES is).
+    # Acceptance (module doc, step 3): standard errors of the paired per-run gain a candidate needs.
     gain_noise_se: float = GAIN_NOISE_SE
+    # False: a candidate is accepted on a lower exact loss alone (the noise, stride-error, collision,
+    # curvature and jerk guards off): ``footfall bench tuning`` compares the optimisers on the loss
+    # alone, as CMA-ES sees it.
+    guards: bool = True
+    # Where the search starts: (GaitTiming field, value) pairs over the default timing, e.g.
+    # (("stride_coefficient", 3.0),) for a mis-tuned start (``footfall bench tuning``). The start is
+    # also what candidates and the held-out runs are compared with. Empty: the defaults.
+    start_timing: tuple = ()
 
     def __post_init__(self) -> None:
         for name in ("rounds", "seed", "harvest_frames", "harvest_characters", "max_situations", "fit_steps",
@@ -135,8 +143,28 @@ class TuneConfig:
         if isinstance(self.gain_noise_se, bool) or not isinstance(self.gain_noise_se, (int, float)) \
                 or not self.gain_noise_se >= 0.0:
             raise InputError("argument", "gain_noise_se", f"expected a number >= 0, got {self.gain_noise_se!r}")
+        if not isinstance(self.guards, bool):
+            raise InputError("argument", "guards", f"expected true or false, got {self.guards!r}")
+        self.start()  # refuses unknown fields and invalid values
         if not self.tau > 0.0:
             raise InputError("argument", "tau", f"expected > 0, got {self.tau}")
+
+    def start(self):
+        """The ``GaitTiming`` the search starts from: the defaults with ``start_timing`` applied."""
+        from planner._timing import TIMING_FIELDS, GaitTiming
+
+        try:
+            pairs = dict((str(name), float(value)) for name, value in self.start_timing)
+        except (TypeError, ValueError):
+            raise InputError("argument", "start_timing",
+                             f"expected (field, number) pairs, got {self.start_timing!r}") from None
+        unknown = sorted(set(pairs) - set(TIMING_FIELDS))
+        if unknown:
+            raise InputError("argument", "start_timing", f"unknown GaitTiming field(s) {', '.join(unknown)}")
+        try:
+            return GaitTiming(**pairs)
+        except ValueError as e:
+            raise InputError("argument", "start_timing", str(e)) from None
 
     def exact_setup(self) -> ExactSetup:
         return ExactSetup(self.creature, scenarios=self.exact_scenarios,
@@ -153,7 +181,10 @@ class TuneConfig:
 
     @classmethod
     def from_json(cls, data: dict) -> "TuneConfig":
-        return cls(**{k: tuple(v) if isinstance(v, list) else v for k, v in data.items()})
+        def frozen(v):
+            return tuple(frozen(x) for x in v) if isinstance(v, list) else v
+
+        return cls(**{k: frozen(v) for k, v in data.items()})
 
 
 @dataclass
@@ -431,9 +462,14 @@ def paired_gain(best: dict, candidate: dict) -> tuple[float, float]:
     return float(d.mean()), float(d.std(ddof=1) / math.sqrt(d.size))
 
 
-def _accept(candidate: dict, best: dict, default: dict, gain_noise_se: float = GAIN_NOISE_SE) -> tuple[bool, str]:
+def _accept(candidate: dict, best: dict, default: dict, gain_noise_se: float = GAIN_NOISE_SE,
+            guards: bool = True) -> tuple[bool, str]:
     if not candidate["finite"]:
         return False, "non-finite run"
+    if not guards:
+        if candidate["exact_loss"] < best["exact_loss"]:
+            return True, "improved"
+        return False, "exact loss did not improve"
     if candidate["collisions"] > default["collisions"]:
         return False, "more collisions than the default weights"
     if candidate["curvature_energy_mean"] > curvature_limit(default, candidate):
@@ -481,7 +517,6 @@ def tune(config: TuneConfig, out: str | Path, resume: bool = False, progress=Non
 
 def _tune(config: TuneConfig, out, resume, progress, stop_after, write, evaluate, map_tasks, t0) -> TuneResult:
     from planner._presets import preset_dict
-    from planner._timing import GaitTiming
     from planner._weights import ScoringWeights
     from scenarios import default_gait_name
     from tuning._config import enable_x64
@@ -499,7 +534,7 @@ def _tune(config: TuneConfig, out, resume, progress, stop_after, write, evaluate
         say(f"resumed at round {state['round']}", state["round"] + 1, total)
     else:
         say("exact loss of the default weights", 0, total)
-        default_params = _params(ScoringWeights().to_array(), GaitTiming().to_array())
+        default_params = _params(ScoringWeights().to_array(), config.start().to_array())
         default_exact = exact_metrics(setup, *_objects(default_params), targets=targets, map_tasks=map_tasks)
         state = {"format": CHECKPOINT_FORMAT, "version": CHECKPOINT_VERSION, "config": config.to_json(),
                  "round": 0, "stopped": False, "current": default_params,
@@ -518,7 +553,8 @@ def _tune(config: TuneConfig, out, resume, progress, stop_after, write, evaluate
         for alpha in LINE_SEARCH:
             params = _towards(state["current"], fitted, alpha)
             candidate = exact_metrics(setup, *_objects(params), targets=targets, map_tasks=map_tasks)
-            accepted, why = _accept(candidate, state["best"]["exact"], state["default_exact"], config.gain_noise_se)
+            accepted, why = _accept(candidate, state["best"]["exact"], state["default_exact"], config.gain_noise_se,
+                                    config.guards)
             tried.append({"alpha": alpha, "exact_loss": candidate["exact_loss"],
                           "stride_rel_error": candidate["stride_rel_error"], "decision": why})
             if accepted:
@@ -542,7 +578,7 @@ def _tune(config: TuneConfig, out, resume, progress, stop_after, write, evaluate
         return TuneResult(preset={}, summary={}, wall_s=time.perf_counter() - t0, finished=True)
     say("held-out evaluation", total - 1, total)
     best = state["best"]
-    default_params = _params(ScoringWeights().to_array(), GaitTiming().to_array())
+    default_params = _params(ScoringWeights().to_array(), config.start().to_array())
     holdout = config.holdout_setup()
     held_default = exact_metrics(holdout, *_objects(default_params), targets=targets, map_tasks=map_tasks)
     held_tuned = exact_metrics(holdout, *_objects(best["params"]), targets=targets, map_tasks=map_tasks)
