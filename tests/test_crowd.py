@@ -172,7 +172,7 @@ def test_a_feet_spacing_change_replans_swinging_feet_and_narrows_the_stance():
 def _walk_too_fast(controller, creature_name="ant", froude=0.32, frames=150, warmup=30):
     """Two characters on flat ground asked for more than their legs sustain (the ant at Fr = 0.32,
     0.40 m/s). Returns (held character-frames, speed_limit at the end, the planned times of the swings
-    begun after the warm-up, stride / target at the realised speed)."""
+    begun after the warm-up, stride / target at the realised speed, the crowd model)."""
     from planner._simulation import realised_strides
     from planner._timing import GRAVITY, hip_height
     from tuning._targets import load_targets
@@ -204,11 +204,12 @@ def test_a_character_asked_for_more_than_its_legs_sustain_slows_down_instead_of_
     gait of the speed it keeps. Without that (a hold forgotten at once: the old controller) the body
     waits and runs on at full speed, and its strides are nearer those of the speed it was asked for."""
     from planner._crowd import ControllerConfig
+    from planner._timing import GRAVITY
 
     holds, limit, _, ratio, model = _walk_too_fast(ControllerConfig(), "spider", froude=0.1)
     stop_and_go = ControllerConfig(hold_backoff=1.0, limit_recovery=1e9)
     holds_old, _, _, ratio_old, _ = _walk_too_fast(stop_and_go, "spider", froude=0.1)
-    desired = math.sqrt(0.1 * 9.81 * model.leg_height)
+    desired = math.sqrt(0.1 * GRAVITY * model.leg_height)
     assert holds_old > 0  # the speed is beyond what the legs sustain
     assert holds > 0 and np.all(limit < desired)  # held, and the limit learnt from it
     # Strides against the target at the realised speed, 2.3 h Fr^0.3.
@@ -221,11 +222,11 @@ def test_steps_begun_while_the_body_stands_take_the_swing_time_of_its_walk():
     resumes, not for the 1 s cap: no swing after the warm-up lasts even one stride at half the
     desired speed (the ant's cycle there is 0.27 s)."""
     from planner._crowd import ControllerConfig
-    from planner._timing import stride_frequency
+    from planner._timing import GRAVITY, stride_frequency
 
     holds, _, swing_times, ratio, model = _walk_too_fast(ControllerConfig())
     assert holds > 0 and swing_times.size > 100
-    half = 0.5 * math.sqrt(0.32 * 9.81 * model.leg_height)
+    half = 0.5 * math.sqrt(0.32 * GRAVITY * model.leg_height)
     assert swing_times.max() < 1.0 / stride_frequency(model.timing, half, model.leg_height)
     assert abs(ratio - 1.0) < 0.05  # the strides of the speed it keeps (stop-and-go: 9 % long)
 
