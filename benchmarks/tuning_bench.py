@@ -28,7 +28,7 @@ on ``TuneConfig.exact_setup()``, the same targets), over the same parameters, fr
 
 ``speedup`` = cmaes ``wall_s`` / proxy ``wall_s``; when CMA-ES did not reach the target within
 ``max_evals`` it is a lower bound (``speedup_is_lower_bound``). Before either clock starts, one
-untimed, uncounted exact evaluation of the default parameters warms the exact planner (numba
+untimed, uncounted exact evaluation of the start parameters warms the exact planner (numba
 caches, scenario rasters), so neither method pays that. Every evaluation is deterministic: the same
 creature, seed and settings give the same evaluations and losses (wall times aside).
 """
@@ -90,16 +90,17 @@ def make_config(creature: str, seed: int = 0, rounds: int = 2, config_overrides:
     unknown = sorted(set(overrides) - fields)
     if unknown:
         raise ValueError(f"config_overrides: unknown TuneConfig field(s) {', '.join(unknown)}")
-    overrides = {k: tuple(v) if isinstance(v, list) else v for k, v in overrides.items()}
     check_creature(creature)
-    return TuneConfig(creature, rounds=rounds, seed=seed, **overrides)
+    # from_json: lists (from JSON or a caller) become the tuples TuneConfig holds, nested ones too.
+    return TuneConfig.from_json({"creature": creature, "rounds": rounds, "seed": seed, **overrides})
 
 
 # --------------------------------------------------------------------------- proxy method
 
 
 def _proxy_record(state: dict, wall_s: float, phases: dict, timed_until: str) -> dict:
-    """Counts from a tune checkpoint: 1 default evaluation + every line-search entry."""
+    """Counts from a tune checkpoint: 1 evaluation of the start (``default_exact_loss``: the tune's
+    reference parameters) + every line-search entry."""
     line_search = [len(r["line_search"]) for r in state["history"]]
     history = [float(state["default_exact"]["exact_loss"])]
     history += [float(e["exact_loss"]) for r in state["history"] for e in r["line_search"]]
