@@ -99,14 +99,14 @@ def make_config(creature: str, seed: int = 0, rounds: int = 2, config_overrides:
 
 
 def _proxy_record(state: dict, wall_s: float, phases: dict, timed_until: str) -> dict:
-    """Counts from a tune checkpoint: 1 evaluation of the start (``default_exact_loss``: the tune's
-    reference parameters) + every line-search entry."""
+    """Counts from a tune checkpoint: 1 evaluation of the start (``start_exact_loss``: the tune's
+    reference parameters, the defaults with ``start_timing`` applied) + every line-search entry."""
     line_search = [len(r["line_search"]) for r in state["history"]]
     history = [float(state["default_exact"]["exact_loss"])]
     history += [float(e["exact_loss"]) for r in state["history"] for e in r["line_search"]]
     return {"wall_s": float(wall_s), "exact_evals": 1 + sum(line_search),
             "exact_loss": float(state["best"]["exact"]["exact_loss"]),
-            "default_exact_loss": history[0], "rounds_run": len(line_search),
+            "start_exact_loss": history[0], "rounds_run": len(line_search),
             "accepted_rounds": sum(bool(r["accepted"]) for r in state["history"]),
             "line_search_evals": line_search, "history": history, "phases_s": phases,
             "timed_until": timed_until}

@@ -344,6 +344,21 @@ def report_cmd(
     out_console.print(f"report: {summary['index']}")
 
 
+def _field_values(items: Optional[list[str]], option: str) -> tuple[tuple[str, float], ...]:
+    """("FIELD=VALUE", ...) -> ((field, value), ...); a malformed item is an InputError naming the option."""
+    pairs = []
+    for item in items or ():
+        name, sep, value = item.partition("=")
+        try:
+            number = float(value)
+        except ValueError:
+            number = None
+        if not sep or not name.strip() or number is None:
+            raise InputError("argument", option, f"expected FIELD=NUMBER, got {item!r}")
+        pairs.append((name.strip(), number))
+    return tuple(pairs)
+
+
 @app.command("tune")
 def tune_cmd(
     creature: str = typer.Option(..., "--creature", help="Built-in creature to tune"),
@@ -352,6 +367,9 @@ def tune_cmd(
     resume: bool = typer.Option(False, "--resume", help="Continue a killed run from its checkpoint"),
     rounds: int = typer.Option(2, "--rounds", help="Outer rounds at most (harvest, fit, exact loss)"),
     seed: int = typer.Option(0, "--seed", help="Seed of the harvests and runs (same seed, same preset)"),
+    start_timing: Optional[list[str]] = typer.Option(
+        None, "--start-timing", help="Start the search from a mis-tuned gait timing, FIELD=VALUE of GaitTiming "
+        "(repeatable, e.g. stride_coefficient=3.0); the summary adds the *_start figures"),
     cluster: Optional[str] = typer.Option(None, help="Dask scheduler address (tcp://host:8786) to run the harvests "
                                           "and exact runs on"),
     workers: Optional[int] = typer.Option(None, help="Local worker processes (default: one per core; 1: in-process)"),
@@ -366,7 +384,7 @@ def tune_cmd(
     check_workers(workers, cluster)
     check_creature(creature)
     path = check_output(out or f"out/presets/{creature}.json")
-    config = TuneConfig(creature, rounds=rounds, seed=seed)
+    config = TuneConfig(creature, rounds=rounds, seed=seed, start_timing=_field_values(start_timing, "--start-timing"))
     bar = Progress(TextColumn("tune"), BarColumn(), TextColumn("{task.description}"), TimeElapsedColumn(),
                    console=_err(), transient=True)
     with bar:

@@ -244,19 +244,26 @@ def harvest_situations(scenarios=("mixed",), creatures=("spider",), *, seeds=(0,
     if max_situations is not None and (isinstance(max_situations, bool) or not isinstance(max_situations, int)
                                        or max_situations < 1):
         raise ValueError(f"max_situations: expected None or an integer >= 1, got {max_situations!r}")
-    if map_tasks is not None and not callable(map_tasks):
-        raise ValueError(f"map_tasks: expected None or a callable, got {type(map_tasks).__name__}")
+    run = task_mapper(map_tasks)
     weights = weights or ScoringWeights()
     timing = timing or GaitTiming()
     tasks = harvest_tasks(scenarios, creatures, seeds, frames, n_characters, weights, timing, max_situations)
-    if map_tasks is None:
-        # Lazily: once the cap is reached the remaining chunks are never run (as the sequential loop did).
-        chunks = (harvest_chunk(task) for task in tasks)
-    else:
-        # Every chunk runs (in parallel); those past the cap are dropped by the merge.
-        chunks = map_tasks(harvest_chunk, tasks)
+    # In this process the chunks run lazily: once the cap is reached the rest never run. With a
+    # map_tasks every chunk runs (in parallel) and those past the cap are dropped by the merge.
+    chunks = run(harvest_chunk, tasks)
     rows = _merge_chunks(chunks, max_situations)
     return _pack(rows, creatures, scenarios, weights.to_array(), timing.to_array())
+
+
+def task_mapper(map_tasks=None):
+    """``map_tasks`` checked, or (``None``) a lazy in-process map: ``run(function, tasks)`` gives the
+    results in task order. One check for every caller that takes a ``map_tasks`` (harvests here,
+    the tune's exact runs)."""
+    if map_tasks is None:
+        return map
+    if not callable(map_tasks):
+        raise ValueError(f"map_tasks: expected None or a callable, got {type(map_tasks).__name__}")
+    return map_tasks
 
 
 def harvest_tasks(scenarios, creatures, seeds, frames: int, n_characters: int, weights: ScoringWeights, timing,

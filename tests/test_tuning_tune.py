@@ -69,6 +69,24 @@ def test_a_killed_run_resumes_to_the_same_preset(tiny_runs):
     assert resumed.summary == whole.summary
 
 
+def test_a_mis_tuned_start_is_reported_beside_the_defaults(tiny_runs, tmp_path):
+    """--start-timing: the search starts from the mis-tuned timing, the *_start keys report it, and
+    the *_default keys still mean the runtime's defaults (the same numbers as a run without a start)."""
+    from tuning._tune import tune
+
+    _, _, whole, _, _, _ = tiny_runs
+    started = tune(_tiny(rounds=1, start_timing=(("stride_coefficient", 3.0),)), tmp_path / "s.json", workers=1)
+    summary = started.summary
+    assert summary["start_timing"] == {"stride_coefficient": 3.0}
+    for key in ("exact_loss", "stride_rel_error", "heldout_stride_rel_error", "heldout_exact_loss"):
+        assert summary[f"{key}_default"] == whole.summary[f"{key}_default"], key
+    # Strides 3.0 / 2.3 = 1.3 times the target's: the start is measurably worse than the defaults.
+    assert summary["stride_rel_error_start"] > summary["stride_rel_error_default"] + 0.1
+    assert summary["exact_loss_tuned"] <= summary["exact_loss_start"]
+    losses = load_preset(tmp_path / "s.json", "spider").provenance["losses"]
+    assert losses["start"]["exact_loss"] == summary["exact_loss_start"]
+
+
 def test_bad_checkpoints_and_arguments_are_refused(tiny_runs, tmp_path):
     from tuning._tune import checkpoint_path, tune
 
@@ -91,7 +109,11 @@ def test_cli_refuses_bad_input_with_one_line():
                         (["--creature", "spider", "--out", "spider.txt"], "--out"),
                         (["--creature", "spider", "--workers", "0"], "--workers"),
                         (["--creature", "spider", "--cluster", "nonsense"], "--cluster"),
-                        (["--creature", "spider", "--cluster", "tcp://127.0.0.1:1", "--workers", "2"], "--workers")):
+                        (["--creature", "spider", "--cluster", "tcp://127.0.0.1:1", "--workers", "2"], "--workers"),
+                        (["--creature", "spider", "--start-timing", "stride_coefficient"], "--start-timing"),
+                        (["--creature", "spider", "--start-timing", "stride_coefficient=x"], "--start-timing"),
+                        (["--creature", "spider", "--start-timing", "stride_coeficient=3"], "stride_coeficient"),
+                        (["--creature", "spider", "--start-timing", "stride_exponent=0.7"], "stride_exponent")):
         proc = subprocess.run([sys.executable, "-m", "footfall.cli", "tune", *args], capture_output=True, text=True,
                               timeout=300)
         assert proc.returncode == 2, proc.stderr

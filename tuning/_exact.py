@@ -60,6 +60,7 @@ import numpy as np
 
 from planner._kernels_foot import RAW_CLEARANCE, RAW_CURVATURE, RAW_JERK
 from planner._simulation import realised_strides
+from planner._harvest import task_mapper
 
 STRIDE_MIN_CELLS = 1.5
 """Lowest speed of the sweep: where the target stride is this many planner cells. Footprints are
@@ -243,8 +244,7 @@ def exact_metrics(setup: ExactSetup, weights=None, timing=None, targets=None, ma
     from planner._timing import stride_length as commanded_stride
     from tuning._targets import load_targets
 
-    if map_tasks is not None and not callable(map_tasks):
-        raise ValueError(f"map_tasks: expected None or a callable, got {type(map_tasks).__name__}")
+    run = task_mapper(map_tasks)
     timing = timing or GaitTiming()
 
     targets = targets or load_targets(creatures=(setup.creature,))
@@ -256,10 +256,7 @@ def exact_metrics(setup: ExactSetup, weights=None, timing=None, targets=None, ma
     jerk_max = t["swing_jerk"].values["maximum"]
     h = t.leg_length_m
     tasks = exact_tasks(setup, weights, timing)
-    if map_tasks is None:
-        runs = [run_exact_task(task) for task in tasks]
-    else:
-        runs = list(map_tasks(run_exact_task, tasks))
+    runs = list(run(run_exact_task, tasks))
     ratios, duty_out, per_run = [], [], []
     raw_all = np.concatenate([r["raw"] for r in runs]) if runs else np.zeros((0, 5))
     for r in runs:

@@ -34,6 +34,11 @@ round trip), every exact result and the seeds: :func:`tune` with ``resume=True``
 continues from it to the same final preset as an uninterrupted run (every step is
 deterministic for its inputs).
 
+The search starts from the default weights and ``TuneConfig.start()``: the default timing,
+or with ``start_timing`` (``footfall tune --start-timing FIELD=VALUE``) a mis-tuned one. The
+guards above then compare with the start. The summary's ``*_default`` keys always mean the
+runtime's defaults; a mis-tuned start adds the same figures as ``*_start``.
+
 Finally the best parameters are evaluated on **held-out** runs (scenarios and seeds
 the fit did not see), and ``spearman_proxy_exact`` -- Spearman's rank correlation
 between the JAX proxy's couple scores (hard scores, the tau -> 0 limit of the
@@ -517,6 +522,7 @@ def tune(config: TuneConfig, out: str | Path, resume: bool = False, progress=Non
 
 def _tune(config: TuneConfig, out, resume, progress, stop_after, write, evaluate, map_tasks, t0) -> TuneResult:
     from planner._presets import preset_dict
+    from planner._timing import GaitTiming
     from planner._weights import ScoringWeights
     from scenarios import default_gait_name
     from tuning._config import enable_x64
@@ -578,15 +584,21 @@ def _tune(config: TuneConfig, out, resume, progress, stop_after, write, evaluate
         return TuneResult(preset={}, summary={}, wall_s=time.perf_counter() - t0, finished=True)
     say("held-out evaluation", total - 1, total)
     best = state["best"]
-    default_params = _params(ScoringWeights().to_array(), config.start().to_array())
     holdout = config.holdout_setup()
-    held_default = exact_metrics(holdout, *_objects(default_params), targets=targets, map_tasks=map_tasks)
+    start_exact = state["default_exact"]  # the checkpoint's name: the start is the defaults unless start_timing
+    held_start = exact_metrics(holdout, *_objects(_params(ScoringWeights().to_array(), config.start().to_array())),
+                               targets=targets, map_tasks=map_tasks)
+    if config.start_timing:
+        # A mis-tuned start: "default" still means the runtime's defaults, measured here too.
+        default_params = _params(ScoringWeights().to_array(), GaitTiming().to_array())
+        default_exact = exact_metrics(setup, *_objects(default_params), targets=targets, map_tasks=map_tasks)
+        held_default = exact_metrics(holdout, *_objects(default_params), targets=targets, map_tasks=map_tasks)
+    else:
+        default_exact, held_default = start_exact, held_start
     held_tuned = exact_metrics(holdout, *_objects(best["params"]), targets=targets, map_tasks=map_tasks)
     rho, n_couples = spearman_proxy_exact(config, best["params"], map_tasks)
     weights, timing = _objects(best["params"])
     from footfall import __version__
-
-    default_exact = state["default_exact"]
 
     def brief(m: dict) -> dict:
         keys = ("exact_loss", "stride_rel_error", "stride_ratio", "collisions", "curvature_energy_mean",
@@ -605,6 +617,12 @@ def _tune(config: TuneConfig, out, resume, progress, stop_after, write, evaluate
         "spearman_proxy_exact": rho, "spearman_couples": n_couples,
         "rounds_run": state["round"], "best_round": best["round"],
     }
+    if config.start_timing:
+        summary.update({
+            "start_timing": dict((str(k), float(v)) for k, v in config.start_timing),
+            "exact_loss_start": start_exact["exact_loss"], "stride_rel_error_start": start_exact["stride_rel_error"],
+            "heldout_stride_rel_error_start": held_start["stride_rel_error"],
+            "heldout_exact_loss_start": held_start["exact_loss"]})
     provenance = {
         "tool": "footfall tune", "footfall_version": __version__,
         "targets": {"file": "tuning/data/targets.toml", "sha256": _file_hash(TARGETS_FILE)[len("sha256:"):],
@@ -628,6 +646,7 @@ def _tune(config: TuneConfig, out, resume, progress, stop_after, write, evaluate
                              "over the runs of |mean stride / mean target - 1|",
         "losses": {"default": brief(default_exact), "tuned": brief(best["exact"]),
                    "heldout_default": brief(held_default), "heldout_tuned": brief(held_tuned),
+                   **({"start": brief(start_exact), "heldout_start": brief(held_start)} if config.start_timing else {}),
                    "rounds": state["history"]},
         "summary": summary,
     }
