@@ -102,7 +102,7 @@ def _proxy_record(state: dict, wall_s: float, phases: dict, timed_until: str) ->
     """Counts from a tune checkpoint: 1 evaluation of the start (``start_exact_loss``: the tune's
     reference parameters, the defaults with ``start_timing`` applied) + every line-search entry."""
     line_search = [len(r["line_search"]) for r in state["history"]]
-    history = [float(state["default_exact"]["exact_loss"])]
+    history = [float(state["start_exact"]["exact_loss"])]
     history += [float(e["exact_loss"]) for r in state["history"] for e in r["line_search"]]
     return {"wall_s": float(wall_s), "exact_evals": 1 + sum(line_search),
             "exact_loss": float(state["best"]["exact"]["exact_loss"]),
@@ -114,10 +114,10 @@ def _proxy_record(state: dict, wall_s: float, phases: dict, timed_until: str) ->
 
 def _phases(marks: list[tuple[str, float]], end: float) -> dict:
     """Seconds per kind of tune step, from the timestamps of its progress messages."""
-    out = {"default_exact": 0.0, "harvest_fit": 0.0, "line_search": 0.0}
+    out = {"start_exact": 0.0, "harvest_fit": 0.0, "line_search": 0.0}
     for (message, start), (_, stop) in zip(marks, marks[1:] + [("", end)]):
-        if message.startswith("exact loss of the default"):
-            out["default_exact"] += stop - start
+        if message.startswith("exact loss of the start"):
+            out["start_exact"] += stop - start
         elif message.endswith("harvest + fit"):
             out["harvest_fit"] += stop - start
         elif message.endswith("exact loss"):

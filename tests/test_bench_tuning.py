@@ -58,7 +58,7 @@ def test_proxy_counts_match_the_checkpoint(runs):
     assert proxy["exact_evals"] == 1 + line_search
     assert len(proxy["history"]) == proxy["exact_evals"]
     assert proxy["exact_loss"] == state["best"]["exact"]["exact_loss"] == result["target_loss"]
-    assert proxy["exact_loss"] <= state["default_exact"]["exact_loss"] == proxy["history"][0]
+    assert proxy["exact_loss"] <= state["start_exact"]["exact_loss"] == proxy["history"][0]
     # Guards off (TuneConfig.guards): every evaluated candidate below the best so far is accepted.
     assert proxy["exact_loss"] == min(proxy["history"])
     # the outer loop alone: no held-out evaluation, no preset written, nothing after it counted or timed
