@@ -244,3 +244,19 @@ def test_a_candidate_must_beat_the_best_by_more_than_the_runs_noise():
     # Guards off (footfall bench tuning): a lower exact loss alone is enough.
     assert _accept(lucky, best, best, guards=False) == (True, "improved")
     assert _accept(_metrics([1.0, 2.0, 3.0], 1.0), best, best, guards=False)[0] is False
+
+
+def test_guards_allow_the_higher_of_the_defaults_and_a_mis_tuned_start():
+    """Median jerk: the defaults 1.0, the start 2.0. A candidate at 1.5 improves on the start and is
+    accepted against the start (it would fail against the defaults alone); one at 2.5 is above both."""
+    from tuning._tune import JERK_GUARD, _accept
+
+    default = _metrics([1.0, 2.0, 3.0], 1.0)
+    start = dict(_metrics([3.0, 4.0, 5.0], 4.0), jerk_median=2.0)
+    mended = dict(_metrics([0.5, 1.5, 2.5], 0.5), jerk_median=1.5)
+    assert 1.5 > (1.0 + JERK_GUARD) * default["jerk_median"]
+    assert _accept(mended, start, default, gain_noise_se=0.0)[0] is False
+    assert _accept(mended, start, default, gain_noise_se=0.0, start=start) == (True, "improved")
+    worse = dict(mended, jerk_median=2.5)
+    accepted, why = _accept(worse, start, default, gain_noise_se=0.0, start=start)
+    assert not accepted and "jerk" in why

@@ -36,8 +36,9 @@ deterministic for its inputs).
 
 The search starts from the default weights and ``TuneConfig.start()``: the default timing,
 or with ``start_timing`` (``footfall tune --start-timing FIELD=VALUE``) a mis-tuned one.
-"Better" is measured from the start; the guards (collisions, curvature, jerk) still compare
-with the runtime's defaults, measured once more before the first round. The summary's
+"Better" is measured from the start; the guards (collisions, curvature, jerk) allow the
+higher of the start's and the runtime defaults' values (the defaults measured once more
+before the first round). The summary's
 ``*_default`` keys always mean the runtime's defaults; a mis-tuned start adds the same
 figures as ``*_start``.
 
@@ -477,19 +478,23 @@ def paired_gain(best: dict, candidate: dict) -> tuple[float, float]:
 
 
 def _accept(candidate: dict, best: dict, default: dict, gain_noise_se: float = GAIN_NOISE_SE,
-            guards: bool = True) -> tuple[bool, str]:
+            guards: bool = True, start: dict | None = None) -> tuple[bool, str]:
+    """(accepted, why). ``default``: the runtime defaults' metrics; ``start``: a mis-tuned start's
+    (None: the start is the defaults). Each guard allows the higher of the two references: a tune
+    may not make collisions, curvature or jerk worse than both where it began and the defaults."""
     if not candidate["finite"]:
         return False, "non-finite run"
     if not guards:
         if candidate["exact_loss"] < best["exact_loss"]:
             return True, "improved"
         return False, "exact loss did not improve"
-    if candidate["collisions"] > default["collisions"]:
-        return False, "more collisions than the default weights"
-    if candidate["curvature_energy_mean"] > curvature_limit(default, candidate):
-        return False, "curvature energy above the default weights'"
-    if candidate["jerk_median"] > (1.0 + JERK_GUARD) * default["jerk_median"]:
-        return False, "median jerk above the default weights' (guard)"
+    references = (default,) if start is None else (default, start)
+    if candidate["collisions"] > max(r["collisions"] for r in references):
+        return False, "more collisions than the default weights (and the start)"
+    if candidate["curvature_energy_mean"] > max(curvature_limit(r, candidate) for r in references):
+        return False, "curvature energy above the default weights' (and the start's)"
+    if candidate["jerk_median"] > (1.0 + JERK_GUARD) * max(r["jerk_median"] for r in references):
+        return False, "median jerk above the default weights' and the start's (guard)"
     if not candidate["exact_loss"] < best["exact_loss"]:
         return False, "exact loss did not improve"
     if candidate["stride_rel_error"] > best["stride_rel_error"]:
@@ -550,9 +555,11 @@ def _tune(config: TuneConfig, out, resume, progress, stop_after, write, evaluate
         say("exact loss of the start", 0, total)
         start_params = _params(ScoringWeights().to_array(), config.start().to_array())
         start_exact = _strip(exact_metrics(setup, *_objects(start_params), targets=targets, map_tasks=map_tasks))
-        # The guards' reference is the runtime's defaults, not a mis-tuned start: from a start with
-        # strides 30 % long the median jerk is lower than the defaults' (the geometric jerk grows as
-        # strides shorten), and a guard against the start refused every step to the target law.
+        # The guards' references are the runtime's defaults and the start (:func:`_accept`): from a
+        # start with strides 30 % long the median jerk is lower than the defaults' (the geometric
+        # jerk grows as strides shorten), and a guard against the start alone refused every step
+        # to the target law; from one with short strides it is higher, and a guard against the
+        # defaults alone refused every step that did not mend the jerk at once.
         default_exact = None if config.start_timing else start_exact  # None: not measured (yet)
         if config.start_timing and config.guards:
             say("exact loss of the default weights (the guards' reference)", 0, total)
@@ -575,7 +582,7 @@ def _tune(config: TuneConfig, out, resume, progress, stop_after, write, evaluate
             params = _towards(state["current"], fitted, alpha)
             candidate = exact_metrics(setup, *_objects(params), targets=targets, map_tasks=map_tasks)
             accepted, why = _accept(candidate, state["best"]["exact"], state["default_exact"], config.gain_noise_se,
-                                    config.guards)
+                                    config.guards, state["start_exact"] if config.start_timing else None)
             tried.append({"alpha": alpha, "exact_loss": candidate["exact_loss"],
                           "stride_rel_error": candidate["stride_rel_error"], "decision": why})
             if accepted:
