@@ -58,9 +58,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from planner._harvest import task_mapper
 from planner._kernels_foot import RAW_CLEARANCE, RAW_CURVATURE, RAW_JERK
 from planner._simulation import realised_strides
-from planner._harvest import task_mapper
 
 STRIDE_MIN_CELLS = 1.5
 """Lowest speed of the sweep: where the target stride is this many planner cells. Footprints are

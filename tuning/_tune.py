@@ -19,12 +19,12 @@ Each outer round r (``rounds`` at most):
    exp(log current + alpha (log fitted - log current)) for alpha in :data:`LINE_SEARCH`,
    the first accepted one kept (a backtracking line search on the exact loss). A candidate is
    accepted if its exact loss is lower than the best so far, by more than the runs' noise
-   (:func:`paired_gain`, :data:`GAIN_NOISE_SE`), its stride error not higher, it
-   has no more collisions than the default weights, its mean curvature energy is not above
-   the default's by more than its sampling noise (:func:`curvature_limit`) and its median
-   jerk not above the default's by more than :data:`tuning._exact.JERK_GUARD` (the jerk
-   target itself cannot be met:
-   see :mod:`tuning._exact`; the fit gives the jerk block zero weight). With
+   (:func:`paired_gain`, :data:`GAIN_NOISE_SE`), its stride error not higher, it has no
+   more collisions than the default weights (or a mis-tuned start, below), its mean
+   curvature energy is not above the default's by more than its sampling noise
+   (:func:`curvature_limit`) and its median jerk not above the default's by more than
+   :data:`tuning._exact.JERK_GUARD` (the jerk target itself cannot be met: see
+   :mod:`tuning._exact`; the fit gives the jerk block zero weight). With
    ``TuneConfig.guards`` false (``footfall bench tuning``) a lower exact loss alone is enough.
    The loop stops at the first round that does not improve (or after ``rounds``).
 
@@ -38,9 +38,8 @@ The search starts from the default weights and ``TuneConfig.start()``: the defau
 or with ``start_timing`` (``footfall tune --start-timing FIELD=VALUE``) a mis-tuned one.
 "Better" is measured from the start; the guards (collisions, curvature, jerk) allow the
 higher of the start's and the runtime defaults' values (the defaults measured once more
-before the first round). The summary's
-``*_default`` keys always mean the runtime's defaults; a mis-tuned start adds the same
-figures as ``*_start``.
+before the first round). The summary's ``*_default`` keys always mean the runtime's
+defaults; a mis-tuned start adds the same figures as ``*_start``.
 
 Finally the best parameters are evaluated on **held-out** runs (scenarios and seeds
 the fit did not see), and ``spearman_proxy_exact`` -- Spearman's rank correlation
