@@ -240,7 +240,15 @@ def _params(weights, timing) -> dict:
     return {"weights": _floats(weights), "timing": _floats(timing)}
 
 
+def _start_params(config: TuneConfig) -> dict:
+    """The default weights and ``config.start()``'s timing: where the search begins."""
+    from planner._weights import ScoringWeights
+
+    return _params(ScoringWeights().to_array(), config.start().to_array())
+
+
 def _default_params() -> dict:
+    """The runtime's defaults (the start when ``start_timing`` is empty)."""
     from planner._timing import GaitTiming
     from planner._weights import ScoringWeights
 
@@ -535,7 +543,6 @@ def tune(config: TuneConfig, out: str | Path, resume: bool = False, progress=Non
 
 def _tune(config: TuneConfig, out, resume, progress, stop_after, write, evaluate, map_tasks, t0) -> TuneResult:
     from planner._presets import preset_dict
-    from planner._weights import ScoringWeights
     from scenarios import default_gait_name
     from tuning._config import enable_x64
     from tuning._targets import TARGETS_FILE, load_targets
@@ -552,7 +559,7 @@ def _tune(config: TuneConfig, out, resume, progress, stop_after, write, evaluate
         say(f"resumed at round {state['round']}", state["round"] + 1, total)
     else:
         say("exact loss of the start", 0, total)
-        start_params = _params(ScoringWeights().to_array(), config.start().to_array())
+        start_params = _start_params(config)
         start_exact = _strip(exact_metrics(setup, *_objects(start_params), targets=targets, map_tasks=map_tasks))
         # The guards' references are the runtime's defaults and the start (:func:`_accept`): from a
         # start with strides 30 % long the median jerk is lower than the defaults' (the geometric
@@ -607,8 +614,7 @@ def _tune(config: TuneConfig, out, resume, progress, stop_after, write, evaluate
     best = state["best"]
     holdout = config.holdout_setup()
     start_exact, default_exact = state["start_exact"], state["default_exact"]
-    held_start = exact_metrics(holdout, *_objects(_params(ScoringWeights().to_array(), config.start().to_array())),
-                               targets=targets, map_tasks=map_tasks)
+    held_start = exact_metrics(holdout, *_objects(_start_params(config)), targets=targets, map_tasks=map_tasks)
     held_default = held_start
     if config.start_timing:
         # A mis-tuned start: "default" still means the runtime's defaults, measured here too.
