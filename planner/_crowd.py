@@ -48,6 +48,8 @@ from planner._params import PlannerConfig, SearchBudget
 from planner._weights import ScoringWeights
 
 DT = 1.0 / 30.0
+TRANSITION_RATE = 0.5
+"""Cycles of phase per second a disk moves during a gait change with speed (a new gait within a stride)."""
 STAGES = ("steer", "gait", "swing", "requests", "maps", "plan", "pelvis", "ik")
 
 
@@ -127,6 +129,10 @@ class CrowdModel:
     reach: np.ndarray  # (L,) leg reach, m
     leg_static: object  # IK statics (planner._ik)
     fixed_budget: SearchBudget | None = None  # with lod_mode 'off': every search gets this budget (evaluation sweeps)
+    schedule: object = None  # planner._gait_schedule.GaitSchedule: the gaits by speed (gait: the slowest)
+    stance_window: np.ndarray | None = None  # (L, 2) body-forward interval each leg carries a stance foot over
+    speed_cap: float = math.inf  # m/s, the fastest speed the legs carry at the stride law (planner._workspace)
+    speed_asked: float = 0.0  # m/s, the scenario's speed before the cap
 
     @property
     def n_legs(self) -> int:
@@ -187,6 +193,8 @@ class CrowdState:
     speed_limit: np.ndarray  # (C,) m/s, the sustainable speed learnt from holds (inf: never held)
     last_move: np.ndarray  # (C, 2) m, the pelvis's move on the ground in the last steer stage
     cannot_follow: np.ndarray  # (C, L) bool: the last look-ahead found the leg cannot follow its stance foot
+    gait_index: np.ndarray  # (C,) int: the schedule's gait each character walks with (or moves toward)
+    stride_frequency: np.ndarray  # (C,) Hz, the needle's rate at the last gait stage
     counters: dict = field(default_factory=dict)
     last_plans: object = None  # (chars, legs, kinds, BatchResult) of the last frame, for recordings
     last_batch: object = None  # the FootBatch planned in the last frame (what the tuning harvest re-scores)
@@ -255,6 +263,10 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
     state.speed_limit[free] += ctl.limit_recovery * state.desired_speed[free] * dt
     v_des = np.minimum(v_des, state.speed_limit)
     state.speed = state.speed + np.clip(v_des - state.speed, -ctl.acceleration * dt, ctl.acceleration * dt)
+    # Legs that reach: no faster than keeps every stance foot inside its leg's stance window until
+    # the needle lifts it (planner._workspace). The cap falls gradually as a foot nears the rear
+    # of its window, so the body slows down instead of stopping dead on a hold.
+    state.speed = np.minimum(state.speed, stance_speed_cap(model, state))
     # The body never outruns its legs: a character with a stance foot its leg cannot follow,
     # and no room to lift it, waits.
     state.speed[state.body_held] = 0.0
@@ -272,12 +284,44 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
         fb[idx] -= move
 
 
+def stance_speed_cap(model: CrowdModel, state: CrowdState) -> np.ndarray:
+    """(C,) the fastest each body may move this frame so that every stance foot stays in front of
+    the rear end of its leg's stance window until its sector starts (inf: no stance foot near)."""
+    g = state.gaits
+    frequency = np.maximum(state.stride_frequency, 1e-9)[:, None]
+    until_lift = np.mod(g.disk_start - g.needle[:, None], 1.0) / frequency + 2.0 * model.dt
+    d = state.feet[..., [0, 2]] - state.pelvis[:, None, [0, 2]]
+    forward = d[..., 0] * np.cos(state.heading)[:, None] + d[..., 1] * np.sin(state.heading)[:, None]
+    room = forward - state.feet_spacing[:, None] * model.stance_window[None, :, 0]
+    cap = np.where(state.in_stance, np.maximum(room, 0.0) / until_lift, np.inf)
+    return cap.min(axis=1)
+
+
 def stage_gait(model: CrowdModel, state: CrowdState):
     """Stride frequency and duty factor from the speed (the destination disks follow the
     duty factor, the disks in use move toward them while in stance), then the needle."""
-    from planner._gait import advance, set_speed
+    from planner._gait import advance, set_destination, set_speed
+    from planner._timing import GRAVITY, stride_length
+    from planner._workspace import duty_ceiling
 
-    frequency = set_speed(state.gaits, model.timing, state.speed, model.leg_height)
+    # Gait changes with speed (planner._gait_schedule): the new gait's disks are the destination.
+    # The gait follows the speed the character heads for (its goal), not the speed of the moment:
+    # a body slowed for a stride by its legs would otherwise flip gaits and restart transitions.
+    schedule = model.schedule
+    if len(schedule.gaits) > 1:
+        goal = np.minimum(state.desired_speed, state.speed_limit)
+        froude = goal**2 / (GRAVITY * model.leg_height)
+        index = schedule.select(state.gait_index, froude)
+        for k in np.unique(index[index != state.gait_index]):
+            set_destination(state.gaits, np.flatnonzero((index == k) & (index != state.gait_index)),
+                            schedule.gaits[int(k)])
+        state.gait_index = index
+    # The stance sweep DF * lambda must fit the narrowest stance window (planner._workspace).
+    stride = stride_length(model.timing, state.speed, model.leg_height)
+    window = float(np.min(model.stance_window[:, 1] - model.stance_window[:, 0]))
+    frequency = set_speed(state.gaits, model.timing, state.speed, model.leg_height,
+                          duty_ceiling(max(window, 1e-9), stride))
+    state.stride_frequency = frequency
     in_air = ~state.in_stance
     enter, fraction = advance(state.gaits, frequency, model.dt, state.in_stance)
     # A foot still in the air when the needle enters its sector (a forced step, a late landing)
@@ -304,6 +348,23 @@ def stage_swing(model: CrowdModel, state: CrowdState, boxes) -> np.ndarray:
     return landed
 
 
+def travel(speed, goal, acceleration: float, duration):
+    """Distance (m) a body at ``speed`` covers in ``duration`` (s) while it changes speed toward
+    ``goal`` at ``acceleration`` (m/s^2) and then keeps it (all broadcast).
+
+    Examples
+    --------
+    >>> float(travel(0.0, 1.0, 1.0, 2.0))   # 0.5 m speeding up for 1 s, then 1 m at 1 m/s
+    1.5
+    >>> float(travel(1.0, 1.0, 1.0, 0.5))
+    0.5
+    """
+    speed, goal, duration = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64) for x in (speed, goal, duration)))
+    ramp = np.minimum(np.abs(goal - speed) / acceleration, duration)
+    sign = np.sign(goal - speed)
+    return speed * ramp + 0.5 * sign * acceleration * ramp**2 + goal * (duration - ramp)
+
+
 def _reach_xz(model: CrowdModel) -> np.ndarray:
     reach = model.controller.reach_margin * model.reach
     dy = model.creature.standing_height + model.hips_body[:, 1]
@@ -323,7 +384,7 @@ def _solve_feet(model: CrowdModel, state: CrowdState, cs, ls, hips, iterations: 
                       max_iterations=iterations, restarts=restarts)
 
 
-def _stance_unreachable_ahead(model: CrowdModel, state: CrowdState, hips) -> np.ndarray:
+def _stance_unreachable_ahead(model: CrowdModel, state: CrowdState, hips, frequency) -> np.ndarray:
     """(C, L) stance feet whose leg could not reach them ``lookahead_frames`` from now
     (IK with the hips carried forward; characters without IK are not checked)."""
     ctl = model.controller
@@ -335,19 +396,24 @@ def _stance_unreachable_ahead(model: CrowdModel, state: CrowdState, hips) -> np.
     cs, ls = np.nonzero(state.in_stance & (state.ik_on & turn)[:, None])
     if cs.size == 0:
         return out.copy()
-    ahead = ctl.lookahead_frames * model.dt * state.speed[cs]
+    # Look no further than the foot's own lift-off: a foot whose sector starts within the horizon
+    # leaves the ground before the body gets there (at speed, 4 frames are a third of a stride).
+    g = state.gaits
+    until_lift = np.mod(g.disk_start[cs, ls] - g.needle[cs], 1.0) / np.maximum(frequency[cs], 1e-9)
+    horizon = np.minimum(ctl.lookahead_frames * model.dt, np.maximum(until_lift, model.dt))
+    ahead = horizon * state.speed[cs]
     shifted = hips[cs, ls].copy()
     shifted[:, 0] += ahead * np.cos(state.heading[cs])
     shifted[:, 2] += ahead * np.sin(state.heading[cs])
     # The pelvis keeps rising (or sinking) as it did over the last frame; rising is what
     # stretches a stance leg, so only a rise is carried forward.
-    shifted[:, 1] += ctl.lookahead_frames * np.maximum(state.pelvis_rise[cs], 0.0)
-    res = _solve_feet(model, state, cs, ls, shifted, iterations=4, restarts=0)
+    shifted[:, 1] += (horizon / model.dt) * np.maximum(state.pelvis_rise[cs], 0.0)
+    res = _solve_feet(model, state, cs, ls, shifted, iterations=ctl.ik_iterations, restarts=ctl.ik_restarts)
     out[cs, ls] = res.residual > ctl.ik_slip_margin
     return out.copy()
 
 
-def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips) -> np.ndarray:
+def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, frequency) -> np.ndarray:
     """(C, L) int8 request kinds: 0 none, 1 new swing, 2 forced step, 3 re-plan."""
     ctl = model.controller
     state.wants_swing |= (enter | state.sector_missed) & state.in_stance
@@ -355,7 +421,7 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips) -> 
     kinds = np.zeros(state.in_stance.shape, dtype=np.int8)
     kinds[state.wants_swing & state.in_stance] = 1
     far = np.hypot(state.feet[..., 0] - hips[..., 0], state.feet[..., 2] - hips[..., 2]) > _reach_xz(model)[None, :]
-    cannot_follow = _stance_unreachable_ahead(model, state, hips)
+    cannot_follow = _stance_unreachable_ahead(model, state, hips, frequency)
     far |= cannot_follow
     centres, sizes, yaws, forbidden, moving = boxes
     threatened = np.zeros(state.in_stance.shape, dtype=np.bool_)
@@ -388,7 +454,11 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips) -> 
     held = (cannot_follow & (kinds == 0)).any(axis=1)
     # Held from this frame on: take back this frame's move (the pelvis pose stays too).
     newly = held & ~state.body_held
-    state.speed_limit[newly] = np.minimum(state.speed_limit[newly], ctl.hold_backoff * state.speed[newly])
+    # A hold right after another one (the body barely moving again) says little about the speed the
+    # legs sustain: one hold at most halves the limit.
+    floor = 0.5 * np.minimum(state.speed_limit[newly], state.desired_speed[newly])
+    state.speed_limit[newly] = np.minimum(state.speed_limit[newly],
+                                          np.maximum(ctl.hold_backoff * state.speed[newly], floor))
     state.pelvis[newly, 0] -= state.last_move[newly, 0]
     state.pelvis[newly, 2] -= state.last_move[newly, 1]
     state.body_held = held
@@ -459,14 +529,30 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     t_swing = np.where(new, np.minimum(durations / freq, 1.0),
                        np.maximum(state.swing_T[cs, ls] - state.swing_t[cs, ls], 2.0 * model.dt))
     duty = state.gaits.duty_factor[cs]
-    t_stance = np.where(np.isfinite(duty), duty, 1.0 - durations) / freq
+    nominal = np.where(np.isfinite(duty), duty, 1.0 - durations)
+    # The stance lasts until the needle next enters the foot's sector: during a gait transition
+    # that is where the sector is heading (the destination start), not the nominal duty factor.
+    g = state.gaits
+    landing_phase = g.needle[cs] + np.where(new, durations, t_swing * freq)
+    until_next = np.mod(g.dest_start[cs, ls] - landing_phase, 1.0)
+    t_stance = np.clip(until_next, 0.5 * nominal, 1.5 * nominal) / freq
     heading = state.heading[cs]
     fwd = np.stack([np.cos(heading), np.sin(heading)], axis=1)
     v = state.speed[cs]
-    pred = state.pelvis[cs][:, [0, 2]] + fwd * (v * t_swing)[:, None]
+    # Where the body will be: it keeps accelerating toward its goal speed (a foot planned at the
+    # start of a speed-up would otherwise land for the slower speed and trail out of reach).
+    goal = np.minimum(state.desired_speed[cs], state.speed_limit[cs])
+    travel_swing = travel(v, goal, model.controller.acceleration, t_swing)
+    pred = state.pelvis[cs][:, [0, 2]] + fwd * travel_swing[:, None]
     spacing = state.feet_spacing[cs]
-    rx, rz = _rot_xz(heading, spacing * model.rest_body[ls, 0], spacing * model.rest_body[ls, 1])
-    preferred = pred + np.stack([rx, rz], axis=1) + fwd * (0.5 * v * t_stance)[:, None]
+    # The stance sweep v * T_stance is centred inside the leg's stance window (planner._workspace):
+    # a leg whose rest foot sits near an end of its window would run out of reach before lift-off.
+    from planner._workspace import stance_centres
+
+    sweep = travel(v, goal, model.controller.acceleration, t_swing + t_stance) - travel_swing
+    centre = stance_centres(spacing * model.rest_body[ls, 0], spacing[:, None] * model.stance_window[ls], sweep)
+    rx, rz = _rot_xz(heading, centre, spacing * model.rest_body[ls, 1])
+    preferred = pred + np.stack([rx, rz], axis=1) + fwd * (0.5 * sweep)[:, None]
     hx, hz = _rot_xz(heading, model.hips_body[ls, 0], model.hips_body[ls, 2])
     hip_pred = pred + np.stack([hx, hz], axis=1)
     foot_yaw = np.arctan2(preferred[:, 1] - hip_pred[:, 1], preferred[:, 0] - hip_pred[:, 0])
@@ -550,7 +636,7 @@ def stage_ik(model: CrowdModel, state: CrowdState, on_screen: np.ndarray) -> Non
         return
     hips = hips_world(model, state)
     ctl = model.controller
-    for stance, restarts, iterations in ((True, ctl.ik_restarts, ctl.ik_iterations), (False, 0, ctl.ik_swing_iterations)):
+    for stance, restarts, iterations in ((True, ctl.ik_restarts, ctl.ik_iterations), (False, ctl.ik_restarts, ctl.ik_swing_iterations)):
         cs, ls = np.nonzero(on_screen[:, None] & (state.in_stance == stance))
         if cs.size == 0:
             continue
@@ -648,24 +734,30 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
     if span + (config.roi_margin_cells + 2) * config.cell_size > map_half:
         raise InputError(creature.name, "legs", f"the creature (reach {span:.2f} m) is too large for its "
                          f"{config.map_cells} x {config.map_cells} local map of {config.cell_size} m cells")
-    speed = float(scenario.crowd.speed)
-    from planner._timing import stride_length
-
-    reach = 0.95 * float(np.min(creature.leg_reach))
-    stride = float(stride_length(timing, np.array([speed]), float(creature.standing_height))[0])
-    if stride > 2.0 * reach:
-        raise InputError(scenario.source, "crowd.speed", f"{speed} m/s needs strides of {stride:.2f} m, beyond "
-                         f"what legs of reach {reach:.2f} m can take")
+    speed_asked = float(scenario.crowd.speed)
     raster = raster or WorldRaster.build(scenario.terrain, scenario.obstacles, config.cell_size)
     if abs(raster.frame.cell_size - config.cell_size) > 1e-12:
         raise ValueError(f"raster: cell size {raster.frame.cell_size} differs from the planner's {config.cell_size}")
     spacing = float(scenario.crowd.feet_spacing)
+    from planner._gait_schedule import as_schedule
+    from planner._timing import hip_height
+    from planner._workspace import speed_cap, stance_windows
+
+    schedule = as_schedule(gait)
+    hips_body = np.asarray(creature.hips, dtype=np.float64)
+    rest_body = spacing * np.asarray(creature.rest_feet, dtype=np.float64)
+    leg_static = legs_of(creature)
+    window = stance_windows(creature, rest_body, hips_body, leg_static)
+    # Past this speed even the least duty factor's stance sweep does not fit the legs' windows:
+    # the controller caps the speed there (reported as speed_cap; the CLI says so).
+    cap = speed_cap(timing, hip_height(creature), float(np.min(window[:, 1] - window[:, 0])))
+    speed = min(speed_asked, cap)
     model = CrowdModel(
-        creature=creature, gait=gait, timing=timing, weights=weights, config=config, controller=controller, lod=lod,
+        creature=creature, gait=schedule.gaits[0], timing=timing, weights=weights, config=config, controller=controller, lod=lod,
         lod_mode=lod_mode, raster=raster, camera=scenario.camera, dt=DT, feet_spacing=spacing,
-        hips_body=np.asarray(creature.hips, dtype=np.float64),
-        rest_body=spacing * np.asarray(creature.rest_feet, dtype=np.float64),
-        reach=np.asarray(creature.leg_reach, dtype=np.float64), leg_static=legs_of(creature), fixed_budget=budget)
+        hips_body=hips_body, rest_body=rest_body, reach=np.asarray(creature.leg_reach, dtype=np.float64),
+        leg_static=leg_static, fixed_budget=budget, schedule=schedule, stance_window=window, speed_cap=cap,
+        speed_asked=speed_asked)
     rng = np.random.default_rng(seed)
     positions = spawn_positions(scenario, creature, n)
     if scenario.crowd.heading_mode == "random":
@@ -690,6 +782,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
     hx, hz = _rot_xz(headings[:, None], model.hips_body[None, :, 0], model.hips_body[None, :, 2])
     yaws = np.arctan2(feet[..., 2] - (pelvis[:, None, 2] + hz), feet[..., 0] - (pelvis[:, None, 0] + hx))
     angles = np.repeat(rest_pose_angles(creature)[None], n, axis=0)
+    gait_index = schedule.initial(np.full(n, speed), hip_height(creature))
     state = CrowdState(
         t=0.0, frame=0, pelvis=pelvis, heading=headings.copy(), pitch=np.zeros(n), roll=np.zeros(n),
         speed=np.zeros(n), desired_speed=np.full(n, speed), route=routes, route_index=np.zeros(n, np.int64),
@@ -698,8 +791,9 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         trajectories=np.repeat(feet[:, :, None, :], K, axis=2), swing_target=feet.copy(),
         plan_heading=np.repeat(headings[:, None], L, axis=1), plan_speed=np.zeros((n, L)),
         feet_spacing=np.ones(n), plan_spacing=np.ones((n, L)), foot_yaws=yaws,
-        gaits=init_gaits([gait] * n, n, rng.uniform(0.0, 1.0, n)), angles=angles, residual=np.zeros((n, L)),
+        gaits=init_gaits([schedule.gaits[int(k)] for k in gait_index], n, rng.uniform(0.0, 1.0, n), transition_rate=TRANSITION_RATE), angles=angles, residual=np.zeros((n, L)),
         ik_on=np.zeros(n, np.bool_), fk_feet=feet.copy(), hull=np.zeros(n), pelvis_rise=np.zeros(n), body_held=np.zeros(n, np.bool_), speed_limit=np.full(n, np.inf), last_move=np.zeros((n, 2)), cannot_follow=np.zeros((n, L), np.bool_),
+        gait_index=gait_index, stride_frequency=np.zeros(n),
         counters={k: 0 for k in ("steps", "plans", "holds", "replans", "forbidden_footprints", "cells_expanded",
                                  "couples_evaluated")})
     stage_pelvis(model, state)
@@ -742,7 +836,7 @@ def step(model: CrowdModel, state: CrowdState) -> dict[str, float]:
     stage_swing(model, state, boxes)
     t3 = clock()
     hips = hips_world(model, state)
-    kinds = stage_requests(model, state, enter, boxes, hips)
+    kinds = stage_requests(model, state, enter, boxes, hips, frequency)
     budgets = character_budgets(model, state)
     t4 = clock()
     chars = np.unique(np.nonzero(kinds)[0])

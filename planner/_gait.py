@@ -275,15 +275,24 @@ def set_destination(state: GaitManagerState, character_indices: Any, gait: Any, 
         state.transition_rate[rows] = rate
 
 
-def set_speed(state: GaitManagerState, timing: GaitTiming, speed: Any, height: Any) -> np.ndarray:
+def set_speed(state: GaitManagerState, timing: GaitTiming, speed: Any, height: Any,
+              duty_ceiling: Any = None) -> np.ndarray:
     """Stride frequencies (C,) at ``speed`` (m/s, number or (C,)) for hip height ``height`` (m, number or
     (C,)); records the duty factors and rescales every destination disk's duration to them
-    (:mod:`planner._timing`). The disks in use follow at the transition rate while in stance."""
+    (:mod:`planner._timing`). The disks in use follow at the transition rate while in stance.
+
+    ``duty_ceiling`` (number or (C,), > 0; default none): the largest duty factor the legs carry
+    at this speed (:func:`planner._workspace.duty_ceiling`); the duty factor never falls below the
+    timing's ``duty_min`` for it."""
     n = state.n_characters
     v = _per_character(speed, n, "speed")
     h = _per_character(height, n, "height", positive=True)
+    ceiling = np.full(n, np.inf) if duty_ceiling is None else np.asarray(duty_ceiling, dtype=np.float64)
+    if ceiling.shape != (n,) or np.any(np.isnan(ceiling)) or np.any(ceiling <= 0.0):
+        raise ValueError(f"duty_ceiling: expected numbers > 0 of shape ({n},)")
     frequency = np.empty(n)
-    retime_gaits(timing.to_array(), v, h, state.gait_duration, frequency, state.duty_factor, state.dest_duration)
+    retime_gaits(timing.to_array(), v, h, np.ascontiguousarray(ceiling), state.gait_duration, frequency,
+                 state.duty_factor, state.dest_duration)
     state.dest_start[...] = state.gait_start
     return frequency
 

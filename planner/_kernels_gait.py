@@ -100,12 +100,15 @@ def scale_swing_durations_k(durations, duty, out):
 
 
 @nb.njit(cache=True)
-def retime_gaits(params, speed, height, gait_duration, out_frequency, out_duty, dest_duration):
+def retime_gaits(params, speed, height, duty_ceiling, gait_duration, out_frequency, out_duty, dest_duration):
     """Per character c: stride frequency and duty factor at ``speed[c]``, ``height[c]``; the destination
-    disks' durations = ``gait_duration[c]`` scaled to that duty factor."""
+    disks' durations = ``gait_duration[c]`` scaled to that duty factor.
+
+    ``duty_ceiling[c]`` lowers the duty factor to what the character's legs carry (the stance sweep
+    ``DF * lambda`` fits their stance window, :mod:`planner._workspace`), never below ``duty_min``."""
     for c in range(speed.shape[0]):
         out_frequency[c] = stride_frequency_k(params, speed[c], height[c])
-        out_duty[c] = duty_factor_k(params, speed[c], height[c])
+        out_duty[c] = max(min(duty_factor_k(params, speed[c], height[c]), duty_ceiling[c]), params[T_DUTY_MIN])
         scale_swing_durations_k(gait_duration[c], out_duty[c], dest_duration[c])
 
 

@@ -8,13 +8,26 @@ Metrics are measured after each frame and are not part of the frame time:
   (hip -> foot) cross, summed over frames;
 * ``max_stance_slip_m``: largest frame-to-frame motion of a stance foot as the
   IK places it (feet the IK solved in both frames);
-* ``ik_residual_p95_m``: 95th percentile of |IK foot - target| over solved legs.
+* ``ik_residual_p95_m``: 95th percentile of |IK foot - target| over solved legs;
+* ``stride_rel_error_median`` / ``_p90``: per stride (one foot's consecutive touch-downs),
+  |lambda_i / lambda*(v_i) - 1|, lambda_i the ground distance between the two footprints, v_i
+  the pelvis's ground speed between them, lambda*(v) = v / f(v) the stride the timing model
+  commands (the target law lambda = c h Fr^e wherever the stride frequency is above its floor);
+  steady strides only: both touch-downs at between half and 1.5 times the character's goal
+  speed (min(asked, speed_cap)), not in the start-up or the stop at the goal (``strides_measured``);
+* ``speed_asked`` (the scenario's speed), ``speed_cap`` (the fastest the legs carry at the stride
+  law, :mod:`planner._workspace`; ``None`` when no cap applies), ``speed_reached`` (median over
+  characters of the pelvis's ground speed over the second half of the run, frames before it
+  reached its goal), ``duty_factor_mean`` (stance fraction of foot-frames after the first
+  second, walking characters), ``gait_fractions`` (share of character-frames in each gait of
+  the creature's schedule).
 """
 
 from __future__ import annotations
 
 import json
-from dataclasses import asdict, dataclass
+import math
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
@@ -46,6 +59,14 @@ class SimulationSummary:
     cells_expanded: int
     couples_evaluated: int
     finite: bool
+    stride_rel_error_median: float | None = None
+    stride_rel_error_p90: float | None = None
+    strides_measured: int = 0
+    speed_asked: float = 0.0
+    speed_cap: float | None = None
+    speed_reached: float = 0.0
+    duty_factor_mean: float | None = None
+    gait_fractions: dict = field(default_factory=dict)
 
     def to_json(self) -> dict:
         return asdict(self)
@@ -120,6 +141,59 @@ def realised_strides(feet, in_stance, pelvis, dt: float):
     return (moved / ((k1 - k0) * dt)).astype(np.float64), stride.astype(np.float64)
 
 
+class StrideMeter:
+    """Per-stride error against the commanded stride law, measured frame by frame (module doc)."""
+
+    def __init__(self, model: CrowdModel, state: CrowdState):
+        c, l = state.in_stance.shape
+        self.model = model
+        self.goal = np.minimum(state.desired_speed, model.speed_cap)
+        self.last_frame = np.full((c, l), -1, np.int64)
+        self.last_foot = np.zeros((c, l, 2))
+        self.last_pelvis = np.zeros((c, l, 2))
+        self.last_speed = np.zeros((c, l))
+        self.errors: list[np.ndarray] = []
+
+    def update(self, k: int, state: CrowdState, landed: np.ndarray) -> None:
+        from planner._timing import stride_frequency
+
+        if not landed.any():
+            return
+        cs, ls = np.nonzero(landed)
+        foot = state.feet[cs, ls][:, [0, 2]]
+        pelvis = state.pelvis[cs][:, [0, 2]]
+        speed = state.speed[cs]
+        goal = self.goal[cs]
+        seen = self.last_frame[cs, ls] >= 0
+        if seen.any():
+            a, b = cs[seen], ls[seen]
+            duration = (k - self.last_frame[a, b]) * self.model.dt
+            stride = np.hypot(*(foot[seen] - self.last_foot[a, b]).T)
+            v = np.hypot(*(pelvis[seen] - self.last_pelvis[a, b]).T) / duration
+            steady = ((self.last_speed[a, b] >= 0.5 * goal[seen]) & (speed[seen] >= 0.5 * goal[seen])
+                      & (self.last_speed[a, b] <= 1.5 * goal[seen]) & (speed[seen] <= 1.5 * goal[seen]) & (v > 0))
+            if steady.any():
+                f = stride_frequency(self.model.timing, v[steady], self.model.leg_height)
+                self.errors.append(np.abs(stride[steady] * f / v[steady] - 1.0))
+        self.last_frame[cs, ls] = k
+        self.last_foot[cs, ls] = foot
+        self.last_pelvis[cs, ls] = pelvis
+        self.last_speed[cs, ls] = speed
+
+    def summary(self) -> tuple[float | None, float | None, int]:
+        if not self.errors:
+            return None, None, 0
+        e = np.concatenate(self.errors)
+        return float(np.median(e)), float(np.percentile(e, 90)), int(e.size)
+
+
+def _arrived(model: CrowdModel, state: CrowdState) -> np.ndarray:
+    last = state.route.shape[1] - 1
+    goal = state.route[:, last]
+    near = np.hypot(*(state.pelvis[:, [0, 2]] - goal).T) < model.controller.arrive_radius
+    return (state.route_index == last) & near
+
+
 def simulate(model: CrowdModel, state: CrowdState, frames: int, recorder: Recorder | None = None,
              progress=None) -> SimulationSummary:
     """Run ``frames`` steps; never raises on a foot that cannot step (it holds)."""
@@ -136,8 +210,27 @@ def simulate(model: CrowdModel, state: CrowdState, frames: int, recorder: Record
     per_char = np.zeros(state.pelvis.shape[0], np.int64)
     foot_hx = 0.5 * model.creature.foot_length
     foot_hz = 0.5 * model.creature.foot_width
+    strides = StrideMeter(model, state)
+    n_chars = state.pelvis.shape[0]
+    travelled = np.zeros(n_chars)
+    walking_frames = np.zeros(n_chars)
+    stance_feet = 0
+    walking_feet = 0
+    gait_frames = np.zeros(len(model.schedule.gaits))
+    first_second = int(round(1.0 / model.dt))
     for k in range(frames):
+        before = state.pelvis[:, [0, 2]].copy()
         timings = step(model, state)
+        landed = state.in_stance & ~prev_stance
+        strides.update(k, state, landed)
+        walking = ~_arrived(model, state)
+        if k >= frames // 2:
+            travelled += np.where(walking, np.hypot(*(state.pelvis[:, [0, 2]] - before).T), 0.0)
+            walking_frames += walking
+        if k >= first_second and walking.any():
+            stance_feet += int(state.in_stance[walking].sum())
+            walking_feet += int(state.in_stance[walking].size)
+        gait_frames += np.bincount(state.gait_index, minlength=gait_frames.size)
         stage_s[k] = [timings[s] for s in STAGES]
         frame_ms[k] = 1e3 * sum(timings.values())
         # -- metrics (not timed) --
@@ -166,10 +259,17 @@ def simulate(model: CrowdModel, state: CrowdState, frames: int, recorder: Record
             progress(k + 1)
     res = np.concatenate(residuals) if residuals else np.zeros(1)
     c = state.counters
+    median, p90, measured = strides.summary()
+    moving = walking_frames > 0
+    reached = float(np.median(travelled[moving] / (walking_frames[moving] * model.dt))) if moving.any() else 0.0
     return SimulationSummary(
         frames=frames, characters=int(state.pelvis.shape[0]), steps=int(c["steps"]), collisions=collisions,
         forbidden_footprints=int(c["forbidden_footprints"]), leg_crossings=crossings, max_stance_slip_m=slip,
         ik_residual_p95_m=float(np.percentile(res, 95)), ms_per_frame_median=float(np.median(frame_ms)), ms_per_frame_mean=float(np.mean(frame_ms)),
         stage_ms_median={s: float(1e3 * np.median(stage_s[:, i])) for i, s in enumerate(STAGES)},
         plans=int(c["plans"]), holds=int(c["holds"]), replans=int(c["replans"]),
-        cells_expanded=int(c["cells_expanded"]), couples_evaluated=int(c["couples_evaluated"]), finite=finite)
+        cells_expanded=int(c["cells_expanded"]), couples_evaluated=int(c["couples_evaluated"]), finite=finite,
+        stride_rel_error_median=median, stride_rel_error_p90=p90, strides_measured=measured,
+        speed_asked=float(model.speed_asked), speed_cap=None if math.isinf(model.speed_cap) else float(model.speed_cap),
+        speed_reached=reached, duty_factor_mean=stance_feet / walking_feet if walking_feet else None,
+        gait_fractions={name: float(n / max(gait_frames.sum(), 1)) for name, n in zip(model.schedule.names, gait_frames)})

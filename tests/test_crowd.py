@@ -109,10 +109,15 @@ def test_impossible_inputs_fail_before_the_simulation(tmp_path):
     gait.write_text(f"[swing]\n{rows}\n")
     _one_line_exit_2(_cli("simulate", "flat", "--creature", "quadruped", "--gait", str(gait), "--frames", "2"),
                      str(gait))
-    # A speed beyond the legs' reach.
+    # A speed beyond the legs' reach is not refused: the controller caps it and says so (issue 13).
     fast = tmp_path / "fast.toml"
     fast.write_text(_scenario_text(terrain='kind = "flat"\nsize = [20.0, 20.0]\ncell_size = 0.05', speed=25.0))
-    _one_line_exit_2(_cli("simulate", str(fast), "--frames", "2"), str(fast), "speed")
+    proc = _cli("simulate", str(fast), "--frames", "60", "--json")
+    assert proc.returncode == 0, proc.stderr
+    summary = json.loads(proc.stdout)
+    assert summary["speed_asked"] == 25.0 and 0.1 < summary["speed_cap"] < 25.0, summary
+    assert summary["speed_reached"] <= summary["speed_cap"] * 1.001, summary
+    assert "capped" in proc.stderr and "speed" in proc.stderr, proc.stderr
     # NaN terrain.
     nan_map = tmp_path / "nan.npy"
     heights = np.zeros((200, 200))

@@ -1,0 +1,157 @@
+"""Where each leg can carry its stance foot: the stance window, and the speed legs can carry.
+
+A stance foot stays where it touched down while the body moves over it, so relative to the
+body it slides backwards by the **stance sweep** ``s = v * T_stance = DF * lambda`` (speed v,
+duty factor DF, stride lambda) between touch-down and lift-off. The leg must reach it along
+the whole sweep. For each leg, the **stance window** is the interval of body-forward
+coordinates ``[lo, hi]`` (m, pelvis frame, at the rest foot's lateral coordinate, on flat
+ground at standing height) where the leg's inverse kinematics, with its joint limits, puts
+the foot on the target; shrunk by :data:`WINDOW_MARGIN` of its length at each end so the
+bobbing pelvis, uneven ground and a late lift-off keep inside it.
+
+Two rules follow (issue 13, "legs that reach"):
+
+* **Stance centre** (:func:`stance_centres`): the preferred footprint is the rest foot plus
+  half a sweep ahead (Raibert's neutral point); a leg whose rest foot sits near one end of
+  its window (a spider's hind legs trail far behind their hips) would run out of reach
+  before lift-off, so the centre of its sweep moves into the window: ``clip(rest, lo + s/2,
+  hi - s/2)``.
+* **Duty ceiling and speed cap** (:func:`duty_ceiling`, :func:`speed_cap`): the sweep fits
+  the narrowest window when ``DF <= window / lambda``; the duty factor is lowered to that
+  ceiling (never below the timing's ``duty_min``: at least half the cycle on the ground).
+  Past the speed where even ``duty_min * lambda`` does not fit, the legs cannot carry the
+  stride law: the controller caps the speed there and says so.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from planner._timing import GRAVITY
+
+WINDOW_MARGIN = 0.08
+"""Fraction of a stance window's length given up at each end."""
+WINDOW_SAMPLES = 161
+"""Forward positions sampled per leg and height when measuring a window."""
+WINDOW_HEIGHTS = (-0.05, 0.0, 0.05)
+"""Foot heights (fractions of the standing height, relative to flat ground) the window must reach at."""
+CENTRE_SLACK = 0.25
+"""Fraction of a window's free room (its length less the sweep) kept clear at each end of a sweep."""
+REACH_TOLERANCE = 1e-4
+"""A target counts as reached when the IK residual is below this (m)."""
+
+
+def stance_windows(creature, rest_body: np.ndarray, hips_body: np.ndarray, legs) -> np.ndarray:
+    """(L, 2) stance window ``[lo, hi]`` of every leg, in body-forward metres from the pelvis.
+
+    Parameters
+    ----------
+    creature : scenarios.Creature
+        Its ``standing_height`` and ``leg_reach`` are used.
+    rest_body : (L, 2) array
+        Rest feet (forward, lateral) in the body frame, feet spacing applied.
+    hips_body : (L, 3) array
+        Hips (forward, up, lateral) in the body frame.
+    legs : planner._ik.CreatureLegs
+        The legs' IK statics.
+
+    Returns
+    -------
+    (L, 2) array
+        The contiguous forward interval around the rest foot that the leg reaches at every
+        height of :data:`WINDOW_HEIGHTS`, shrunk by :data:`WINDOW_MARGIN`. A leg that cannot
+        reach its own rest foot gets the one-point window ``[rest, rest]``.
+    """
+    from planner._ik import solve_legs
+
+    n_legs = rest_body.shape[0]
+    reach = np.asarray(creature.leg_reach, dtype=np.float64)
+    height = float(creature.standing_height)
+    k = WINDOW_SAMPLES
+    offsets = np.linspace(-1.0, 1.0, k)
+    reached = np.ones((n_legs, k), dtype=np.bool_)
+    forward = rest_body[:, 0:1] + offsets[None, :] * reach[:, None]
+    for fraction in WINDOW_HEIGHTS:
+        targets = np.stack([forward, np.full_like(forward, -height * (1.0 - fraction)),
+                            np.broadcast_to(rest_body[:, 1:2], forward.shape)], axis=-1).reshape(-1, 3)
+        leg = np.repeat(np.arange(n_legs), k)
+        result = solve_legs(hips_body[leg], np.broadcast_to(np.eye(3), (leg.size, 3, 3)), legs.rest_azimuths[leg],
+                            legs.segment_lengths[leg], legs.limits[leg], legs.azimuth_limits[leg], targets,
+                            max_iterations=48, restarts=8, parallel=False)
+        reached &= (result.residual < REACH_TOLERANCE).reshape(n_legs, k)
+    windows = np.repeat(rest_body[:, 0:1], 2, axis=1).astype(np.float64)
+    middle = k // 2
+    for i in range(n_legs):
+        if not reached[i, middle]:
+            continue
+        lo = middle
+        while lo > 0 and reached[i, lo - 1]:
+            lo -= 1
+        hi = middle
+        while hi < k - 1 and reached[i, hi + 1]:
+            hi += 1
+        a, b = forward[i, lo], forward[i, hi]
+        shrink = WINDOW_MARGIN * (b - a)
+        windows[i] = (a + shrink, b - shrink)
+    return windows
+
+
+def stance_centres(rest_forward: np.ndarray, windows: np.ndarray, sweep: np.ndarray) -> np.ndarray:
+    """Body-forward centre of each stance sweep: ``clip(rest, lo + s/2 + q, hi - s/2 - q)``,
+    ``q = CENTRE_SLACK * (hi - lo - s)``.
+
+    A sweep longer than its window is centred on the window.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> stance_centres(np.array([0.05, 0.0]), np.array([[-0.3, 0.3], [-0.1, 0.1]]), np.array([0.1, 0.3]))
+    array([0.05, 0.  ])
+    >>> stance_centres(np.array([-0.28]), np.array([[-0.3, 0.3]]), np.array([0.1]))  # -0.3 + 0.05 + 0.125
+    array([-0.125])
+    """
+    # Keep a quarter of the free room at each end when the window allows it: a stance can last
+    # longer than planned (a gait change moving the foot's sector, a late landing).
+    slack = CENTRE_SLACK * np.maximum(windows[..., 1] - windows[..., 0] - sweep, 0.0)
+    lo = windows[..., 0] + 0.5 * sweep + slack
+    hi = windows[..., 1] - 0.5 * sweep - slack
+    centre = np.minimum(np.maximum(rest_forward, lo), hi)
+    return np.where(lo <= hi, centre, 0.5 * (windows[..., 0] + windows[..., 1]))
+
+
+def duty_ceiling(window: float, stride) -> np.ndarray:
+    """Largest duty factor whose stance sweep ``DF * stride`` fits ``window`` (inf where stride is 0).
+
+    Examples
+    --------
+    >>> duty_ceiling(0.3, [0.0, 0.5])
+    array([inf, 0.6])
+    """
+    stride = np.asarray(stride, dtype=np.float64)
+    with np.errstate(divide="ignore"):
+        return np.where(stride > 0.0, window / np.where(stride > 0.0, stride, 1.0), np.inf)
+
+
+def speed_cap(timing, leg_height: float, window: float) -> float:
+    """The fastest speed (m/s) whose stride ``lambda(v)`` the legs carry at the least duty factor.
+
+    ``duty_min * lambda(v) <= window`` with ``lambda = c h Fr^e`` gives
+    ``Fr <= (window / (duty_min c h))^(1/e)``; ``inf`` when the stride does not grow with speed
+    (``e = 0``) and fits, ``0`` when it never fits.
+
+    Examples
+    --------
+    >>> from planner._timing import GaitTiming
+    >>> v = speed_cap(GaitTiming(), 0.42, 0.3)   # Fr = (0.3 / 0.5 / (2.3 * 0.42)) ** (1 / 0.3) = 0.2044
+    >>> round(v, 3)                               # sqrt(0.2044 * 9.81 * 0.42)
+    0.918
+    """
+    c = timing.stride_coefficient
+    e = timing.stride_exponent
+    longest = window / timing.duty_min
+    if e == 0.0:
+        return math.inf if c * leg_height <= longest else 0.0
+    froude = (longest / (c * leg_height)) ** (1.0 / e)
+    return math.sqrt(froude * GRAVITY * leg_height)

@@ -1,0 +1,101 @@
+"""Legs that reach and gaits that change with speed (issue 13): stance windows, the speed cap,
+the gait schedule, and what a walking creature realises per stride."""
+
+import math
+
+import numpy as np
+import pytest
+
+from planner._gait_schedule import HYSTERESIS, GaitSchedule
+from planner._ik import legs_of
+from planner._timing import GRAVITY, GaitTiming, stride_length
+from planner._workspace import WINDOW_HEIGHTS, WINDOW_MARGIN, WINDOW_SAMPLES, duty_ceiling, speed_cap, stance_centres, stance_windows
+from scenarios import load_creature
+
+UPRIGHT_LEG = """
+name = "stilt"
+standing_height = 0.30
+body_thickness = 0.05
+body_box = [0.4, 0.2]
+foot = {{ length = 0.02, width = 0.02 }}
+
+[leg_defaults]
+segments = [0.2, 0.2]
+joint_limits = [[-3.0, 3.0], [-3.0, 3.0]]
+
+[[legs]]
+name = "A"
+hip = [0.1, 0.0, 0.1]
+rest_foot = [0.1, 0.1]
+
+[[legs]]
+name = "B"
+hip = [-0.1, 0.0, 0.1]
+rest_foot = [-0.1, 0.1]
+
+[[legs]]
+name = "C"
+hip = [0.0, 0.0, -0.1]
+rest_foot = [0.0, -0.1]
+"""
+
+
+def test_the_stance_window_of_an_upright_two_segment_leg_is_its_reach_circle(tmp_path):
+    # A foot straight under its hip, free azimuth, joints free: the leg reaches a ground point at
+    # forward offset x when x^2 + d^2 <= (0.2 + 0.2)^2, d the depth below the hip. The window must
+    # hold at the deepest height of WINDOW_HEIGHTS: d = 0.30 * (1 + 0.05) = 0.315, so
+    # |x| <= sqrt(0.16 - 0.099225) = 0.24652; less the margin at each end.
+    path = tmp_path / "stilt.toml"
+    path.write_text(UPRIGHT_LEG.format())
+    creature = load_creature(path)
+    rest = np.asarray(creature.rest_feet)
+    windows = stance_windows(creature, rest, np.asarray(creature.hips), legs_of(creature))
+    depth = 0.30 * 1.05
+    half = math.sqrt(0.4**2 - depth**2)
+    step = 2 * 0.4 / (WINDOW_SAMPLES - 1)  # the sampling resolution of a window's ends
+    for leg in range(3):
+        lo, hi = windows[leg]
+        length = hi - lo
+        raw = length / (1.0 - 2 * WINDOW_MARGIN)
+        assert abs(raw - 2 * half) <= 2 * step, (leg, raw, 2 * half)
+        assert abs(0.5 * (lo + hi) - rest[leg, 0]) <= step, (leg, lo, hi)
+
+
+def test_stance_centres_keep_the_sweep_inside_the_window():
+    windows = np.array([[-0.3, 0.3], [-0.3, 0.3], [-0.1, 0.1], [0.0, 0.2]])
+    rest = np.array([0.0, -0.28, 0.0, 0.19])
+    sweep = np.array([0.2, 0.2, 0.3, 0.1])
+    # free room 0.4 -> slack 0.1 at each end: centre in [-0.3 + 0.1 + 0.1, 0.3 - 0.1 - 0.1] = [-0.1, 0.1]
+    # a sweep longer than its window: the window's middle; free room 0.1 -> slack 0.025: [0.075, 0.125]
+    np.testing.assert_allclose(stance_centres(rest, windows, sweep), [0.0, -0.1, 0.0, 0.125])
+
+
+def test_the_speed_cap_is_where_the_least_duty_factor_just_fits():
+    timing = GaitTiming()
+    for h, window in ((0.12, 0.1), (0.42, 0.3), (0.05, 0.04)):
+        v = speed_cap(timing, h, window)
+        sweep = timing.duty_min * stride_length(timing, v, h)
+        assert sweep == pytest.approx(window, rel=1e-12)
+        assert timing.duty_min * stride_length(timing, 1.01 * v, h) > window
+    np.testing.assert_array_equal(duty_ceiling(0.3, [0.0, 0.6, 0.3]), [np.inf, 0.5, 1.0])
+
+
+def _gait(name, starts):
+    from types import SimpleNamespace
+
+    return SimpleNamespace(name=name, leg_names=("a", "b", "c", "d"), swing_start=starts, swing_duration=[0.25] * 4)
+
+
+def test_the_schedule_moves_up_and_down_with_hysteresis():
+    schedule = GaitSchedule((_gait("walk", [0, .25, .5, .75]), _gait("trot", [0, .5, .5, 0]),
+                             _gait("gallop", [0, .1, .5, .6])), (0.3, 1.0))
+    current = np.array([0, 0, 1, 1, 1, 2, 2, 0])
+    froude = np.array([0.29, 0.31, 0.25, HYSTERESIS * 0.3 - 1e-9, 1.2, 0.9, 0.79, 2.0])
+    # 0: stays walk; 1: up to trot; 2: inside the hysteresis band, stays trot; 3: just below 0.24,
+    # back to walk; 4: up to gallop; 5: stays gallop (0.9 > 0.8); 6: below 0.8, down to trot;
+    # 7: walk at Fr 2 goes up two gaits in one call.
+    np.testing.assert_array_equal(schedule.select(current, froude), [0, 1, 1, 0, 2, 2, 1, 2])
+    np.testing.assert_array_equal(schedule.initial(np.sqrt(np.array([0.1, 0.5, 3.0]) * GRAVITY * 0.5), 0.5),
+                                  [0, 1, 2])
+    with pytest.raises(ValueError, match="froude_up"):
+        GaitSchedule((_gait("walk", [0, .25, .5, .75]), _gait("trot", [0, .5, .5, 0])), (0.5, 0.6))
