@@ -136,3 +136,28 @@ def count_forbidden_landings(landed, feet, foot_hx, foot_hz, foot_yaws, box_cent
                                                   box_forbidden, box_forbidden):
                 n += 1
     return n
+
+
+@nb.njit(cache=True, parallel=True)
+def count_polyline_crossings(joints, out):
+    """Per character, pairs of legs whose rendered ground projections cross: leg i's polyline
+    (``joints[c, i]``, P points, hip first) against leg j's, every segment pair (a crossing at a
+    shared hip does not count: proper intersections only)."""
+    n_chars, n_legs, n_points, _ = joints.shape
+    for c in nb.prange(n_chars):
+        n = 0
+        for i in range(n_legs):
+            for j in range(i + 1, n_legs):
+                crossed = False
+                for a in range(n_points - 1):
+                    if crossed:
+                        break
+                    for b in range(n_points - 1):
+                        if segments_cross(joints[c, i, a, 0], joints[c, i, a, 2], joints[c, i, a + 1, 0],
+                                          joints[c, i, a + 1, 2], joints[c, j, b, 0], joints[c, j, b, 2],
+                                          joints[c, j, b + 1, 0], joints[c, j, b + 1, 2]):
+                            crossed = True
+                            break
+                if crossed:
+                    n += 1
+        out[c] = n

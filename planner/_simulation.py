@@ -1,14 +1,9 @@
 """Running a crowd for many frames: metrics, timings and the recording.
 
 Metrics are measured after each frame and are not part of the frame time:
-* ``collisions``: feet (stance or swing) overlapping a box below its top (a
-  forbidden box at any height), summed over feet and frames;
+* ``collisions``, ``leg_crossings``, ``max_stance_slip_m`` and ``ik_residual_p95_m`` are
+  measured on the rendered pose by :class:`planner._counters.FrameCounters` (see there);
 * ``forbidden_footprints``: landings touching a forbidden box;
-* ``leg_crossings``: pairs of legs of a character whose ground projections
-  (hip -> foot) cross, summed over frames;
-* ``max_stance_slip_m``: largest frame-to-frame motion of a stance foot as the
-  IK places it (feet the IK solved in both frames);
-* ``ik_residual_p95_m``: 95th percentile of |IK foot - target| over solved legs;
 * ``stride_rel_error_median`` / ``_p90``: per stride (one foot's consecutive touch-downs),
   |lambda_i / lambda*(v_i) - 1|, lambda_i the ground distance between the two footprints, v_i
   the pelvis's ground speed between them, lambda*(v) = v / f(v) the stride the timing model
@@ -32,8 +27,8 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from footfall._atomic import atomic_path
-from planner._crowd import STAGES, CrowdModel, CrowdState, hips_world, step
-from planner._kernels_controller import count_collisions, count_leg_crossings
+from planner._crowd import STAGES, CrowdModel, CrowdState, step
+from planner._counters import FrameCounters
 from planner._weights import N_TERMS
 
 RECORDING_FORMAT = "footfall-recording"
@@ -199,17 +194,9 @@ def simulate(model: CrowdModel, state: CrowdState, frames: int, recorder: Record
     """Run ``frames`` steps; never raises on a foot that cannot step (it holds)."""
     frame_ms = np.zeros(frames)
     stage_s = np.zeros((frames, len(STAGES)))
-    collisions = 0
-    crossings = 0
-    slip = 0.0
-    residuals = []
-    prev_fk = state.fk_feet.copy()
+    counters = FrameCounters(model, state)
     prev_stance = state.in_stance.copy()
-    prev_ik = state.ik_on.copy()
     finite = True
-    per_char = np.zeros(state.pelvis.shape[0], np.int64)
-    foot_hx = 0.5 * model.creature.foot_length
-    foot_hz = 0.5 * model.creature.foot_width
     strides = StrideMeter(model, state)
     n_chars = state.pelvis.shape[0]
     travelled = np.zeros(n_chars)
@@ -233,39 +220,23 @@ def simulate(model: CrowdModel, state: CrowdState, frames: int, recorder: Record
         gait_frames += np.bincount(state.gait_index, minlength=gait_frames.size)
         stage_s[k] = [timings[s] for s in STAGES]
         frame_ms[k] = 1e3 * sum(timings.values())
-        # -- metrics (not timed) --
-        obs = model.raster.obstacles
-        if len(obs.yaws):
-            centres, yaws = obs.poses_at(state.t)
-            count_collisions(state.feet, foot_hx, foot_hz, state.foot_yaws, np.ascontiguousarray(centres),
-                             np.ascontiguousarray(obs.sizes, dtype=np.float64), np.ascontiguousarray(yaws),
-                             np.ascontiguousarray(obs.forbidden, dtype=np.bool_), per_char)
-            collisions += int(per_char.sum())
-        count_leg_crossings(hips_world(model, state), state.feet, per_char)
-        crossings += int(per_char.sum())
-        both = state.in_stance & prev_stance & (state.ik_on & prev_ik)[:, None]
-        if both.any():
-            slip = max(slip, float(np.linalg.norm(state.fk_feet[both] - prev_fk[both], axis=1).max()))
-        if state.ik_on.any():
-            residuals.append(state.residual[state.ik_on].ravel().copy())
-        prev_fk[:] = state.fk_feet
+        # -- metrics (not timed), on the rendered pose (planner._counters) --
+        counters.update(state)
         prev_stance[:] = state.in_stance
-        prev_ik[:] = state.ik_on
         finite = finite and bool(np.isfinite(state.pelvis).all() and np.isfinite(state.feet).all()
                                  and np.isfinite(state.angles).all())
         if recorder is not None:
             recorder.capture(k, state, timings)
         if progress is not None:
             progress(k + 1)
-    res = np.concatenate(residuals) if residuals else np.zeros(1)
     c = state.counters
     median, p90, measured = strides.summary()
     moving = walking_frames > 0
     reached = float(np.median(travelled[moving] / (walking_frames[moving] * model.dt))) if moving.any() else 0.0
     return SimulationSummary(
-        frames=frames, characters=int(state.pelvis.shape[0]), steps=int(c["steps"]), collisions=collisions,
-        forbidden_footprints=int(c["forbidden_footprints"]), leg_crossings=crossings, max_stance_slip_m=slip,
-        ik_residual_p95_m=float(np.percentile(res, 95)), ms_per_frame_median=float(np.median(frame_ms)), ms_per_frame_mean=float(np.mean(frame_ms)),
+        frames=frames, characters=int(state.pelvis.shape[0]), steps=int(c["steps"]), collisions=counters.collisions,
+        forbidden_footprints=int(c["forbidden_footprints"]), leg_crossings=counters.leg_crossings, max_stance_slip_m=counters.max_stance_slip_m,
+        ik_residual_p95_m=counters.ik_residual_p95(), ms_per_frame_median=float(np.median(frame_ms)), ms_per_frame_mean=float(np.mean(frame_ms)),
         stage_ms_median={s: float(1e3 * np.median(stage_s[:, i])) for i, s in enumerate(STAGES)},
         plans=int(c["plans"]), holds=int(c["holds"]), replans=int(c["replans"]),
         cells_expanded=int(c["cells_expanded"]), couples_evaluated=int(c["couples_evaluated"]), finite=finite,

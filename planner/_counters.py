@@ -1,0 +1,93 @@
+"""The safety counters of a run, measured on what is rendered (issue 20, item 2).
+
+Every frame, :class:`FrameCounters` reads the crowd state after :func:`planner._crowd.step` and
+counts, on the **rendered** pose (the feet and leg segments where the IK put them; the planned
+feet for characters whose IK is off, which is how they are drawn):
+
+* ``collisions``: feet overlapping a box below its top (a forbidden box at any height);
+* ``leg_crossings``: pairs of legs of a character whose ground projections cross (the legs'
+  polylines, hip -> knees -> foot, from forward kinematics of the IK angles);
+* ``max_stance_slip_m``: the largest distance between a stance foot and the point where it
+  touched down, while it stays down (rendered foot; and the planned foot itself, which must not
+  move at all): a foot that creeps with the body is caught however slowly it creeps;
+* ``ik_residual``: |IK foot - target| of every solved leg (the summary takes its 95th percentile).
+
+Each counter is tested on hand-made states where it must read a known non-zero value
+(``tests/test_counters.py``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from planner._kernels_controller import count_collisions, count_polyline_crossings
+
+
+def rendered_joints(model, state) -> np.ndarray:
+    """(C, L, S + 2, 3) joint positions as drawn: forward kinematics of the IK angles, the hip
+    first and the foot last; for characters whose IK is off, a straight hip -> planned foot leg."""
+    from planner._crowd import hips_world
+    from planner._ik import body_rotation, forward_legs
+
+    c, l = state.in_stance.shape
+    legs = model.leg_static
+    hips = hips_world(model, state)
+    rotations = np.repeat(body_rotation(state.heading, state.pitch, state.roll)[:, None], l, axis=1)
+    joints = forward_legs(hips.reshape(-1, 3), rotations.reshape(-1, 3, 3), np.tile(legs.rest_azimuths, c),
+                          np.tile(legs.segment_lengths, (c, 1)), state.angles.reshape(c * l, -1))
+    joints = joints.reshape(c, l, -1, 3)[:, :, 1:]  # rows 0 and 1 are both the hip
+    off = ~state.ik_on
+    if off.any():
+        straight = np.linspace(0.0, 1.0, joints.shape[2])[None, None, :, None]
+        joints[off] = hips[off][:, :, None] + straight * (state.feet[off] - hips[off])[:, :, None]
+    return joints
+
+
+class FrameCounters:
+    """Accumulates the counters of the module doc over the frames of a run."""
+
+    def __init__(self, model, state):
+        self.model = model
+        self.collisions = 0
+        self.leg_crossings = 0
+        self.max_stance_slip_m = 0.0
+        self.residuals: list[np.ndarray] = []
+        self._per_char = np.zeros(state.pelvis.shape[0], np.int64)
+        self._stance = state.in_stance.copy()
+        self._anchor = self._rendered_feet(state).copy()  # where each stance foot is (rendered)
+        self._planned = state.feet.copy()
+
+    @staticmethod
+    def _rendered_feet(state) -> np.ndarray:
+        return np.where(state.ik_on[:, None, None], state.fk_feet, state.feet)
+
+    def update(self, state) -> None:
+        model = self.model
+        feet = np.ascontiguousarray(self._rendered_feet(state))
+        obs = model.raster.obstacles
+        if len(obs.yaws):
+            centres, yaws = obs.poses_at(state.t)
+            count_collisions(feet, 0.5 * model.creature.foot_length, 0.5 * model.creature.foot_width, state.foot_yaws,
+                             np.ascontiguousarray(centres), np.ascontiguousarray(obs.sizes, dtype=np.float64),
+                             np.ascontiguousarray(yaws), np.ascontiguousarray(obs.forbidden, dtype=np.bool_),
+                             self._per_char)
+            self.collisions += int(self._per_char.sum())
+        count_polyline_crossings(np.ascontiguousarray(rendered_joints(model, state)), self._per_char)
+        self.leg_crossings += int(self._per_char.sum())
+        # Stance slip against the touch-down point: feet that stayed down keep their anchor, feet
+        # that just landed take a new one.
+        stayed = state.in_stance & self._stance
+        if stayed.any():
+            rendered = np.linalg.norm(feet[stayed] - self._anchor[stayed], axis=1).max()
+            planned = np.linalg.norm(state.feet[stayed] - self._planned[stayed], axis=1).max()
+            self.max_stance_slip_m = max(self.max_stance_slip_m, float(rendered), float(planned))
+        landed = state.in_stance & ~self._stance
+        self._anchor[landed] = feet[landed]
+        self._planned[landed] = state.feet[landed]
+        self._stance[:] = state.in_stance
+        if state.ik_on.any():
+            self.residuals.append(state.residual[state.ik_on].ravel().copy())
+
+    def ik_residual_p95(self) -> float:
+        res = np.concatenate(self.residuals) if self.residuals else np.zeros(1)
+        return float(np.percentile(res, 95))

@@ -1,0 +1,88 @@
+"""Every safety counter reads a known non-zero value on a hand-made failure, and zero once the
+failure is fixed; counters measure the rendered pose (issue 20, item 2)."""
+
+import numpy as np
+import pytest
+
+from planner._counters import FrameCounters
+from planner._crowd import init_crowd, stage_ik
+from scenarios import load_creature, load_scenario
+from scenarios._gait_schedule import gait_schedule
+
+
+def _standing(scenario="crates", creature="spider"):
+    s, c = load_scenario(scenario), load_creature(creature)
+    model, state = init_crowd(s, c, gait_schedule(c), n_characters=2, seed=0)
+    return model, state
+
+
+def test_a_foot_inside_a_forbidden_box_is_one_collision_per_frame():
+    model, state = _standing()
+    counters = FrameCounters(model, state)
+    counters.update(state)
+    assert counters.collisions == 0
+    # The hand-placed forbidden crate of `crates` stands at (-2.0, 0.1), 0.4 x 0.5 m, 0.3 m high.
+    state.feet[1, 3] = (-2.0, 0.05, 0.1)
+    state.ik_on[1] = False  # drawn where planned
+    counters.update(state)
+    assert counters.collisions == 1
+    # Rendered, not planned: the IK puts the foot there too (the leg reaches as far as it can).
+    state.ik_on[1] = True
+    state.fk_feet[1, 3] = (-2.0, 0.05, 0.1)
+    state.feet[1, 3] = (5.0, 0.0, 5.0)
+    counters.update(state)
+    assert counters.collisions == 2
+    state.fk_feet[1, 3] = state.feet[1, 3]
+    counters.update(state)
+    assert counters.collisions == 2  # fixed: no more
+
+
+def test_two_legs_whose_feet_swap_sides_cross_once():
+    model, state = _standing("flat")
+    counters = FrameCounters(model, state)
+    counters.update(state)
+    assert counters.leg_crossings == 0
+    # Swap the feet of two neighbouring legs (L1, L2) of character 0 and let the IK place them:
+    # their hip -> foot projections now cross each other and nothing else.
+    state.feet[0, [0, 1]] = state.feet[0, [1, 0]]
+    stage_ik(model, state, np.ones(2, np.bool_))
+    assert np.all(state.residual[0, :2] < 1e-3)
+    counters.update(state)
+    assert counters.leg_crossings == 1
+    state.feet[0, [0, 1]] = state.feet[0, [1, 0]]
+    stage_ik(model, state, np.ones(2, np.bool_))
+    counters.update(state)
+    assert counters.leg_crossings == 1
+
+
+def test_a_stance_foot_creeping_slowly_is_caught_against_its_touch_down_point():
+    model, state = _standing("flat")
+    counters = FrameCounters(model, state)
+    # 0.1 mm per frame: no single frame moves 1 mm, 20 frames move 2 mm from the touch-down point.
+    for _ in range(20):
+        state.feet[0, 2, 0] += 1e-4
+        state.fk_feet[0, 2, 0] += 1e-4
+        counters.update(state)
+    assert counters.max_stance_slip_m == pytest.approx(2e-3, rel=1e-9)
+    # A foot that lifts and lands elsewhere does not slip.
+    fresh = FrameCounters(model, state)
+    state.in_stance[0, 2] = False
+    fresh.update(state)
+    state.feet[0, 2, 0] += 0.1
+    state.fk_feet[0, 2, 0] += 0.1
+    state.in_stance[0, 2] = True
+    fresh.update(state)
+    fresh.update(state)
+    assert fresh.max_stance_slip_m == 0.0
+
+
+def test_a_target_out_of_reach_shows_in_the_ik_residual():
+    model, state = _standing("flat")
+    counters = FrameCounters(model, state)
+    counters.update(state)
+    assert counters.ik_residual_p95() < 1e-4
+    reach = float(model.reach[0])
+    state.feet[:, :, 1] -= 2.0 * reach  # every foot two reaches below its hip
+    stage_ik(model, state, np.ones(2, np.bool_))
+    counters.update(state)
+    assert counters.ik_residual_p95() > reach  # p95 over both frames' legs: half of them are this far
