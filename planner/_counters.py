@@ -10,7 +10,13 @@ feet for characters whose IK is off, which is how they are drawn):
 * ``max_stance_slip_m``: the largest distance between a stance foot and the point where it
   touched down, while it stays down (rendered foot; and the planned foot itself, which must not
   move at all): a foot that creeps with the body is caught however slowly it creeps;
-* ``ik_residual``: |IK foot - target| of every solved leg (the summary takes its 95th percentile).
+* ``ik_residual``: |IK foot - target| of every solved leg (the summary takes its 95th percentile);
+* ``body_overlaps``: pairs of characters whose projected body boxes (``body_box`` about the
+  pelvis, along the heading) overlap, summed over frames;
+* ``shared_foot_spots``: pairs of stance feet of different characters closer than a foot
+  length, summed over frames;
+* ``stuck_seconds``: character-seconds in which a character that has not reached its goal
+  moved less than 10 % of its asked speed over the last 2 s (:data:`STUCK_WINDOW_S`).
 
 Each counter is tested on hand-made states where it must read a known non-zero value
 (``tests/test_counters.py``).
@@ -20,7 +26,17 @@ from __future__ import annotations
 
 import numpy as np
 
-from planner._kernels_controller import count_collisions, count_polyline_crossings
+from planner._kernels_controller import (
+    count_body_overlaps,
+    count_close_pairs,
+    count_collisions,
+    count_polyline_crossings,
+)
+
+STUCK_WINDOW_S = 2.0
+"""Window over which a character's progress is measured for ``stuck_seconds``."""
+STUCK_FRACTION = 0.1
+"""A character moving less than this fraction of its asked speed over the window is stuck."""
 
 
 def rendered_joints(model, state) -> np.ndarray:
@@ -52,6 +68,12 @@ class FrameCounters:
         self.leg_crossings = 0
         self.max_stance_slip_m = 0.0
         self.residuals: list[np.ndarray] = []
+        self.body_overlaps = 0
+        self.shared_foot_spots = 0
+        self.stuck_frames = 0
+        window = int(round(STUCK_WINDOW_S / model.dt))
+        self._trail = np.repeat(state.pelvis[None, :, :][:, :, [0, 2]], window, axis=0)  # ring of positions
+        self._frames = 0
         self._per_char = np.zeros(state.pelvis.shape[0], np.int64)
         self._stance = state.in_stance.copy()
         self._anchor = self._rendered_feet(state).copy()  # where each stance foot is (rendered)
@@ -87,6 +109,34 @@ class FrameCounters:
         self._stance[:] = state.in_stance
         if state.ik_on.any():
             self.residuals.append(state.residual[state.ik_on].ravel().copy())
+        self._crowd(state, feet)
+
+    def _crowd(self, state, feet) -> None:
+        model = self.model
+        n = state.pelvis.shape[0]
+        if n > 1:
+            box = model.creature.body_box
+            count_body_overlaps(np.ascontiguousarray(state.pelvis[:, [0, 2]]), np.ascontiguousarray(state.heading),
+                                0.5 * float(box[0]), 0.5 * float(box[1]), self._per_char)
+            self.body_overlaps += int(self._per_char.sum())
+            cs, ls = np.nonzero(state.in_stance)
+            self.shared_foot_spots += int(count_close_pairs(np.ascontiguousarray(feet[cs, ls][:, [0, 2]]), cs,
+                                                            float(model.creature.foot_length)))
+        # Stuck: not at the goal, and less than 10 % of the asked speed over the window.
+        window = self._trail.shape[0]
+        slot = self._frames % window
+        since = np.hypot(*(state.pelvis[:, [0, 2]] - self._trail[slot]).T)
+        self._trail[slot] = state.pelvis[:, [0, 2]]
+        self._frames += 1
+        if self._frames >= window:
+            from planner._simulation import arrived
+
+            asked = STUCK_FRACTION * state.desired_speed * STUCK_WINDOW_S
+            self.stuck_frames += int(((since < asked) & ~arrived(model, state)).sum())
+
+    @property
+    def stuck_seconds(self) -> float:
+        return self.stuck_frames * self.model.dt
 
     def ik_residual_p95(self) -> float:
         res = np.concatenate(self.residuals) if self.residuals else np.zeros(1)

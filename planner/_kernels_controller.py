@@ -161,3 +161,64 @@ def count_polyline_crossings(joints, out):
                 if crossed:
                     n += 1
         out[c] = n
+
+
+@nb.njit(cache=True, parallel=True)
+def count_body_overlaps(centres, headings, half_length, half_width, out):
+    """Per character c, the other characters whose projected body box (an oriented rectangle of
+    half extents ``half_length`` x ``half_width`` about its pelvis, along its heading) overlaps
+    c's. Each overlapping pair is counted once, at its lower index (``out.sum()`` = pairs)."""
+    n = centres.shape[0]
+    reach = 2.0 * math.hypot(half_length, half_width)
+    for c in nb.prange(n):
+        k = 0
+        for d in range(c + 1, n):
+            dx = centres[d, 0] - centres[c, 0]
+            dz = centres[d, 1] - centres[c, 1]
+            if abs(dx) > reach or abs(dz) > reach:
+                continue
+            if rects_overlap(centres[c, 0], centres[c, 1], half_length, half_width, headings[c], centres[d, 0],
+                             centres[d, 1], half_length, half_width, headings[d]):
+                k += 1
+        out[c] = k
+
+
+@nb.njit(cache=True)
+def count_close_pairs(points, owner, radius):
+    """Pairs of points closer than ``radius`` (ground plane) that belong to different owners,
+    through a uniform grid of cell ``radius`` (sorted cell keys), so it stays near linear."""
+    n = points.shape[0]
+    if n < 2:
+        return 0
+    x0 = points[:, 0].min()
+    z0 = points[:, 1].min()
+    cols = int((points[:, 0].max() - x0) / radius) + 1
+    keys = np.empty(n, dtype=np.int64)
+    for i in range(n):
+        keys[i] = int((points[i, 1] - z0) / radius) * cols + int((points[i, 0] - x0) / radius)
+    order = np.argsort(keys, kind="mergesort")
+    sorted_keys = keys[order]
+    count = 0
+    r2 = radius * radius
+    for a in range(n):
+        i = order[a]
+        ci = int((points[i, 0] - x0) / radius)
+        ri = int((points[i, 1] - z0) / radius)
+        for dr in range(-1, 2):
+            for dc in range(-1, 2):
+                cc = ci + dc
+                rr = ri + dr
+                if cc < 0 or cc >= cols or rr < 0:
+                    continue
+                key = rr * cols + cc
+                lo = np.searchsorted(sorted_keys, key, side="left")
+                hi = np.searchsorted(sorted_keys, key, side="right")
+                for b in range(lo, hi):
+                    j = order[b]
+                    if j <= i or owner[j] == owner[i]:
+                        continue
+                    dx = points[j, 0] - points[i, 0]
+                    dz = points[j, 1] - points[i, 1]
+                    if dx * dx + dz * dz < r2:
+                        count += 1
+    return count

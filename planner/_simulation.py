@@ -62,6 +62,9 @@ class SimulationSummary:
     speed_reached: float = 0.0
     duty_factor_mean: float | None = None
     gait_fractions: dict = field(default_factory=dict)
+    body_overlaps: int = 0
+    shared_foot_spots: int = 0
+    stuck_seconds: float = 0.0
 
     def to_json(self) -> dict:
         return asdict(self)
@@ -182,7 +185,8 @@ class StrideMeter:
         return float(np.median(e)), float(np.percentile(e, 90)), int(e.size)
 
 
-def _arrived(model: CrowdModel, state: CrowdState) -> np.ndarray:
+def arrived(model: CrowdModel, state: CrowdState) -> np.ndarray:
+    """(C,) characters within ``arrive_radius`` of the last point of their route."""
     last = state.route.shape[1] - 1
     goal = state.route[:, last]
     near = np.hypot(*(state.pelvis[:, [0, 2]] - goal).T) < model.controller.arrive_radius
@@ -210,7 +214,7 @@ def simulate(model: CrowdModel, state: CrowdState, frames: int, recorder: Record
         timings = step(model, state)
         landed = state.in_stance & ~prev_stance
         strides.update(k, state, landed)
-        walking = ~_arrived(model, state)
+        walking = ~arrived(model, state)
         if k >= frames // 2:
             travelled += np.where(walking, np.hypot(*(state.pelvis[:, [0, 2]] - before).T), 0.0)
             walking_frames += walking
@@ -243,4 +247,6 @@ def simulate(model: CrowdModel, state: CrowdState, frames: int, recorder: Record
         stride_rel_error_median=median, stride_rel_error_p90=p90, strides_measured=measured,
         speed_asked=float(model.speed_asked), speed_cap=None if math.isinf(model.speed_cap) else float(model.speed_cap),
         speed_reached=reached, duty_factor_mean=stance_feet / walking_feet if walking_feet else None,
+        body_overlaps=counters.body_overlaps, shared_foot_spots=counters.shared_foot_spots,
+        stuck_seconds=counters.stuck_seconds,
         gait_fractions={name: float(n / max(gait_frames.sum(), 1)) for name, n in zip(model.schedule.names, gait_frames)})

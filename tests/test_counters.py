@@ -86,3 +86,43 @@ def test_a_target_out_of_reach_shows_in_the_ik_residual():
     stage_ik(model, state, np.ones(2, np.bool_))
     counters.update(state)
     assert counters.ik_residual_p95() > reach  # p95 over both frames' legs: half of them are this far
+
+
+def test_two_bodies_on_one_spot_overlap_once_per_frame_and_share_their_feet():
+    model, state = _standing("flat")
+    counters = FrameCounters(model, state)
+    counters.update(state)
+    assert (counters.body_overlaps, counters.shared_foot_spots) == (0, 0)
+    # Character 1 stands exactly where character 0 stands: one overlapping pair, and each of the
+    # 8 stance feet shares its spot with the other's twin (8 pairs).
+    state.pelvis[1] = state.pelvis[0]
+    state.feet[1] = state.feet[0]
+    state.fk_feet[1] = state.fk_feet[0]
+    state.heading[1] = state.heading[0]
+    fresh = FrameCounters(model, state)
+    fresh.update(state)
+    assert fresh.body_overlaps == 1
+    assert fresh.shared_foot_spots == model.n_legs
+    # Side by side, bodies 1 mm apart (spider body box 0.25 x 0.15 m): no overlap.
+    side = FrameCounters(model, state)
+    lateral = np.array([-np.sin(state.heading[0]), 0.0, np.cos(state.heading[0])]) * (0.15 + 1e-3)
+    state.pelvis[1] += lateral
+    state.feet[1] += 10.0  # and the feet far away
+    state.fk_feet[1] += 10.0
+    side.update(state)
+    assert (side.body_overlaps, side.shared_foot_spots) == (0, 0)
+
+
+def test_a_character_that_does_not_move_for_three_seconds_is_stuck_for_one():
+    model, state = _standing("flat")
+    counters = FrameCounters(model, state)
+    frames = int(round(3.0 / model.dt))
+    for _ in range(frames):  # nobody moves: after the 2 s window fills, both are stuck for 1 s
+        state.t += model.dt
+        counters.update(state)
+    assert counters.stuck_seconds == pytest.approx(2 * (frames - int(round(2.0 / model.dt)) + 1) * model.dt)
+    moving = FrameCounters(model, state)
+    for _ in range(frames):  # 0.5 x the asked speed: not stuck
+        state.pelvis[:, 0] += 0.5 * state.desired_speed * model.dt
+        moving.update(state)
+    assert moving.stuck_seconds == 0.0
