@@ -735,18 +735,23 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         raise InputError(creature.name, "legs", f"the creature (reach {span:.2f} m) is too large for its "
                          f"{config.map_cells} x {config.map_cells} local map of {config.cell_size} m cells")
     speed_asked = float(scenario.crowd.speed)
-    raster = raster or WorldRaster.build(scenario.terrain, scenario.obstacles, config.cell_size)
+    spacing = float(scenario.crowd.feet_spacing)
+    hips_body = np.asarray(creature.hips, dtype=np.float64)
+    rest_body = spacing * np.asarray(creature.rest_feet, dtype=np.float64)
+    leg_static = legs_of(creature)
+    # A safe box taller than the creature can step onto is forbidden for it (it walks around).
+    from planner._workspace import highest_step
+
+    obstacles = _too_tall_forbidden(scenario.obstacles, highest_step(creature, rest_body, hips_body, leg_static))
+    if raster is None or (obstacles is not scenario.obstacles and raster.obstacles is scenario.obstacles):
+        raster = WorldRaster.build(scenario.terrain, obstacles, config.cell_size)
     if abs(raster.frame.cell_size - config.cell_size) > 1e-12:
         raise ValueError(f"raster: cell size {raster.frame.cell_size} differs from the planner's {config.cell_size}")
-    spacing = float(scenario.crowd.feet_spacing)
     from planner._gait_schedule import as_schedule
     from planner._timing import hip_height
     from planner._workspace import speed_cap, stance_windows
 
     schedule = as_schedule(gait)
-    hips_body = np.asarray(creature.hips, dtype=np.float64)
-    rest_body = spacing * np.asarray(creature.rest_feet, dtype=np.float64)
-    leg_static = legs_of(creature)
     window = stance_windows(creature, rest_body, hips_body, leg_static)
     # Past this speed even the least duty factor's stance sweep does not fit the legs' windows:
     # the controller caps the speed there (reported as speed_cap; the CLI says so).
@@ -800,6 +805,19 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
     state.pelvis_rise[:] = 0.0
     stage_ik(model, state, np.ones(n, np.bool_))
     return model, state
+
+
+def _too_tall_forbidden(obstacles, highest: float):
+    """``obstacles`` with every safe box taller than ``highest`` (m) flagged forbidden (the same
+    object when none is)."""
+    import dataclasses
+
+    if len(obstacles.yaws) == 0:
+        return obstacles
+    tall = ~np.asarray(obstacles.forbidden) & (np.asarray(obstacles.sizes)[:, 1] > highest + 1e-9)
+    if not tall.any():
+        return obstacles
+    return dataclasses.replace(obstacles, forbidden=np.asarray(obstacles.forbidden) | tall)
 
 
 def _initial_feet(model: CrowdModel, positions, headings):

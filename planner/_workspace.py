@@ -155,3 +155,35 @@ def speed_cap(timing, leg_height: float, window: float) -> float:
         return math.inf if c * leg_height <= longest else 0.0
     froude = (longest / (c * leg_height)) ** (1.0 / e)
     return math.sqrt(froude * GRAVITY * leg_height)
+
+
+STEP_SAMPLES = 41
+"""Heights sampled (from the ground up to the standing height) when measuring the highest step."""
+
+
+def highest_step(creature, rest_body: np.ndarray, hips_body: np.ndarray, legs) -> float:
+    """The highest box top (m above the ground the creature stands on) every leg reaches with its
+    foot at its rest position, the pelvis at standing height; never above the standing height
+    (a step onto something taller than the hips is a climb, which the planner does not do).
+
+    A safe box taller than this counts as forbidden for the creature (issue 14: an ant that walks
+    onto a crate three times its height cannot walk on)."""
+    from planner._ik import solve_legs
+
+    n_legs = rest_body.shape[0]
+    height = float(creature.standing_height)
+    rises = np.linspace(0.0, height, STEP_SAMPLES)
+    targets = np.stack([np.repeat(rest_body[:, 0], rises.size), np.tile(rises - height, n_legs),
+                        np.repeat(rest_body[:, 1], rises.size)], axis=1)
+    leg = np.repeat(np.arange(n_legs), rises.size)
+    result = solve_legs(hips_body[leg], np.broadcast_to(np.eye(3), (leg.size, 3, 3)), legs.rest_azimuths[leg],
+                        legs.segment_lengths[leg], legs.limits[leg], legs.azimuth_limits[leg], targets,
+                        max_iterations=48, restarts=8, parallel=False)
+    reached = (result.residual < REACH_TOLERANCE).reshape(n_legs, rises.size)
+    best = height
+    for i in range(n_legs):
+        k = 0
+        while k + 1 < rises.size and reached[i, k + 1]:
+            k += 1
+        best = min(best, float(rises[k]) if reached[i, 0] else 0.0)
+    return best
