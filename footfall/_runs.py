@@ -18,8 +18,18 @@ def recorded_run(scenario, creature, gait, *, frames: int, characters: int | Non
     model, state = init_crowd(scenario, creature, gait, n_characters=characters, seed=seed, weights=weights,
                               timing=timing, lod_mode=lod)
     recorder = Recorder(model, state, frames) if record else None
+    say_speed_cap(model)
     summary = simulate(model, state, frames, recorder, progress=progress)
     return model, summary, recorder
+
+
+def say_speed_cap(model) -> None:
+    """One note on stderr when the creature's legs cannot carry the asked speed (the controller caps it)."""
+    import sys
+
+    if model.speed_asked > model.speed_cap:
+        print(f"footfall: note: {model.creature.name}: {model.speed_asked:g} m/s asked; speed capped at "
+              f"{model.speed_cap:.3g} m/s, the fastest its legs carry at the stride law", file=sys.stderr)
 
 
 def load_named_preset(value: str, creature: str):
