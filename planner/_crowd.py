@@ -133,6 +133,7 @@ class CrowdModel:
     stance_window: np.ndarray | None = None  # (L, 2) body-forward interval each leg carries a stance foot over
     speed_cap: float = math.inf  # m/s, the fastest speed the legs carry at the stride law (planner._workspace)
     speed_asked: float = 0.0  # m/s, the scenario's speed before the cap
+    step_height: float = 0.0  # m, the swings' preferred lift (paper §3.1 'step height')
 
     @property
     def n_legs(self) -> int:
@@ -577,7 +578,7 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
                             axis=1),
         sources=np.ascontiguousarray(state.feet[cs, ls]), preferred=np.ascontiguousarray(preferred),
         hips=np.ascontiguousarray(hip_pred), reach_xz=_reach_xz(model)[ls],
-        step_height=np.full(f, model.controller.step_height_factor * model.creature.standing_height),
+        step_height=np.full(f, model.step_height),
         legs=np.ascontiguousarray(legs), legs_start=np.arange(f + 1, dtype=np.int64) * 2 * (n_legs - 1),
         block_radius=np.full(f, math.hypot(model.creature.foot_length, model.creature.foot_width)),
         couples_after_first=couples[cs], slice_size=slices[cs],
@@ -742,7 +743,11 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
     # A safe box taller than the creature can step onto is forbidden for it (it walks around).
     from planner._workspace import highest_step
 
-    obstacles = _too_tall_forbidden(scenario.obstacles, highest_step(creature, rest_body, hips_body, leg_static))
+    highest = highest_step(creature, rest_body, hips_body, leg_static)
+    obstacles = _too_tall_forbidden(scenario.obstacles, highest)
+    # The swing's lift stays well inside what the legs reach (half the highest step): a foot
+    # lifted to the edge of its workspace mid-swing leaves the IK no continuous way there.
+    step_height = min(controller.step_height_factor * float(creature.standing_height), 0.5 * highest)
     if raster is None or (obstacles is not scenario.obstacles and raster.obstacles is scenario.obstacles):
         raster = WorldRaster.build(scenario.terrain, obstacles, config.cell_size)
     if abs(raster.frame.cell_size - config.cell_size) > 1e-12:
@@ -762,7 +767,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         lod_mode=lod_mode, raster=raster, camera=scenario.camera, dt=DT, feet_spacing=spacing,
         hips_body=hips_body, rest_body=rest_body, reach=np.asarray(creature.leg_reach, dtype=np.float64),
         leg_static=leg_static, fixed_budget=budget, schedule=schedule, stance_window=window, speed_cap=cap,
-        speed_asked=speed_asked)
+        speed_asked=speed_asked, step_height=step_height)
     rng = np.random.default_rng(seed)
     positions = spawn_positions(scenario, creature, n)
     if scenario.crowd.heading_mode == "random":
