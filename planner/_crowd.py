@@ -667,7 +667,7 @@ def spawn_positions(scenario, creature, n: int, spacing_factor: float = 1.5):
     golden = math.pi * (3.0 - math.sqrt(5.0))
     for factor in (spacing_factor, 1.25, 1.0):
         spacing = factor * rest
-        m = 4 * n + 64
+        m = 8 * n + 64
         k = np.arange(m)
         r = spacing * np.sqrt(k / math.pi)  # sunflower spiral: neighbours about `spacing` apart
         a = k * golden
@@ -678,9 +678,14 @@ def spawn_positions(scenario, creature, n: int, spacing_factor: float = 1.5):
         if len(box_r):
             d = np.hypot(pts[:, None, 0] - centres[None, :, 0], pts[:, None, 1] - centres[None, :, 2])
             clear = (d > box_r[None, :] + rest + 0.1).all(axis=1)
-        ok = np.flatnonzero(inside & clear)
-        if ok.size >= n:
-            return pts[ok[:n]]
+        # The spiral's neighbours are only about `spacing` apart (its first two points 0.56 x):
+        # keep a point only if it is at least `spacing` from every point kept before it.
+        kept: list[int] = []
+        for i in np.flatnonzero(inside & clear):
+            if not kept or np.min(np.hypot(*(pts[kept] - pts[i]).T)) >= spacing - 1e-9:
+                kept.append(int(i))
+                if len(kept) == n:
+                    return pts[kept]
     raise InputError(scenario.source, "crowd.count", f"no room for {n} x {creature.name} clear of the obstacles")
 
 

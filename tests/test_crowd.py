@@ -237,3 +237,19 @@ def test_a_foot_in_the_air_when_its_sector_starts_lifts_again_on_landing():
     step(model, state)  # lands, and lifts again at once
     assert not state.in_stance[0, leg] and state.swing_t[0, leg] == 0.0
     assert not state.sector_missed[0, leg]
+
+
+@pytest.mark.parametrize("scenario_name", builtin_scenario_names())
+def test_crowds_spawn_as_far_apart_as_promised(scenario_name):
+    """spawn_positions promises 1.5 rest radii between characters (crowds of 8 to 64 fit at that
+    spacing in every built-in world); the spiral alone put its first two points 0.56 x apart."""
+    from planner._crowd import spawn_positions
+
+    scenario = load_scenario(scenario_name)
+    for creature_name in builtin_creature_names():
+        creature = load_creature(creature_name)
+        for n in (8, 16, 64):
+            pts = spawn_positions(scenario, creature, n)
+            d = np.hypot(pts[:, None, 0] - pts[None, :, 0], pts[:, None, 1] - pts[None, :, 1])
+            d[np.arange(n), np.arange(n)] = np.inf
+            assert d.min() >= 1.5 * creature.rest_radius - 1e-9, (scenario_name, creature_name, n, d.min())
