@@ -96,6 +96,7 @@ class ControllerConfig:
     ik_restarts: int = 2  # restarts of a stalled stance leg (each scans poses: the costly part)
     hold_backoff: float = 0.85  # speed limit after a hold, x the speed held at
     limit_recovery: float = 0.1  # growth of the speed limit, x desired speed per second
+    others_in_maps: bool = False  # other characters' bodies and stance feet are forbidden in the local maps
 
     def __post_init__(self) -> None:
         if not 0.0 < self.hold_backoff <= 1.0:
@@ -503,7 +504,36 @@ def stage_maps(model: CrowdModel, state: CrowdState, chars: np.ndarray, boxes):
     build_local_maps(r.ground, r.static_top, r.static_forbidden, r.frame.origin_x, r.frame.origin_z,
                      r.frame.cell_size, np.ascontiguousarray(state.pelvis[chars][:, [0, 2]]), centres, sizes, yaws,
                      forbidden, moving, elev, ground, forb, origin)
+    if model.controller.others_in_maps:
+        _stamp_others(model, state, chars, forb, origin)
     return elev, ground, forb, origin
+
+
+def _stamp_others(model: CrowdModel, state: CrowdState, chars: np.ndarray, forb, origin) -> None:
+    """Other characters' bodies and stance feet into the planning characters' obstacles' maps."""
+    from scipy.spatial import cKDTree
+
+    from planner._kernels_maps import stamp_other_characters
+
+    n = state.pelvis.shape[0]
+    if n < 2:
+        return
+    xz = np.ascontiguousarray(state.pelvis[:, [0, 2]])
+    half_map = 0.5 * model.config.map_cells * model.config.cell_size
+    radius = math.sqrt(2.0) * half_map + model.rest_radius + float(np.max(model.reach))
+    lists = cKDTree(xz).query_ball_point(xz[chars], radius)
+    counts = np.array([len(x) - 1 for x in lists], dtype=np.int64)
+    start = np.zeros(chars.size + 1, dtype=np.int64)
+    np.cumsum(counts, out=start[1:])
+    index = np.empty(start[-1], dtype=np.int64)
+    for k, (c, found) in enumerate(zip(chars, lists)):
+        others = [j for j in found if j != c]
+        index[start[k]:start[k + 1]] = sorted(others)
+    box = model.creature.body_box
+    stamp_other_characters(forb, origin, model.config.cell_size, start, index, xz,
+                           np.ascontiguousarray(state.heading), 0.5 * float(box[0]), 0.5 * float(box[1]),
+                           np.ascontiguousarray(state.feet[..., [0, 2]]), np.ascontiguousarray(state.in_stance),
+                           0.5 * float(model.creature.foot_length))
 
 
 def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, maps, chars, hips):

@@ -13,7 +13,7 @@ import math
 import numba as nb
 import numpy as np
 
-from planner._kernels_geometry import rasterise_boxes
+from planner._kernels_geometry import rasterise_boxes, rect_overlaps_aabb
 
 
 @nb.njit(cache=True)
@@ -65,3 +65,39 @@ def build_local_maps(ground, static_top, static_forbidden, g_origin_x, g_origin_
                          box_forbidden, box_moving, selected)
         out_origin[k, 0] = ox
         out_origin[k, 1] = oz
+
+
+@nb.njit(cache=True)
+def _stamp_rect(forb, ox, oz, cell, cx, cz, hx, hz, yaw):
+    n_rows, n_cols = forb.shape
+    ex = hx * abs(math.cos(yaw)) + hz * abs(math.sin(yaw))
+    ez = hx * abs(math.sin(yaw)) + hz * abs(math.cos(yaw))
+    c0 = max(0, int(math.floor((cx - ex - ox) / cell)))
+    c1 = min(n_cols - 1, int(math.floor((cx + ex - ox) / cell)))
+    r0 = max(0, int(math.floor((cz - ez - oz) / cell)))
+    r1 = min(n_rows - 1, int(math.floor((cz + ez - oz) / cell)))
+    for r in range(r0, r1 + 1):
+        az = oz + (r + 0.5) * cell
+        for c in range(c0, c1 + 1):
+            ax = ox + (c + 0.5) * cell
+            if rect_overlaps_aabb(cx, cz, hx, hz, yaw, ax, az, 0.5 * cell, 0.5 * cell):
+                forb[r, c] = 1
+
+
+@nb.njit(cache=True, parallel=True)
+def stamp_other_characters(out_forb, out_origin, cell, neighbour_start, neighbour_index, pelvis_xz, headings,
+                           body_half_length, body_half_width, feet_xz, in_stance, foot_half):
+    """Flag, in map k, the projected bodies and the stance feet of the characters listed in
+    ``neighbour_index[neighbour_start[k]:neighbour_start[k + 1]]`` as forbidden (issue 14: a foot
+    never lands on another's foot or inside another's body; swing paths go around them)."""
+    for k in nb.prange(out_forb.shape[0]):
+        ox = out_origin[k, 0]
+        oz = out_origin[k, 1]
+        for a in range(neighbour_start[k], neighbour_start[k + 1]):
+            j = neighbour_index[a]
+            _stamp_rect(out_forb[k], ox, oz, cell, pelvis_xz[j, 0], pelvis_xz[j, 1], body_half_length,
+                        body_half_width, headings[j])
+            for i in range(feet_xz.shape[1]):
+                if in_stance[j, i]:
+                    _stamp_rect(out_forb[k], ox, oz, cell, feet_xz[j, i, 0], feet_xz[j, i, 1], foot_half, foot_half,
+                                0.0)
