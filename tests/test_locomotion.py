@@ -99,3 +99,55 @@ def test_the_schedule_moves_up_and_down_with_hysteresis():
                                   [0, 1, 2])
     with pytest.raises(ValueError, match="froude_up"):
         GaitSchedule((_gait("walk", [0, .25, .5, .75]), _gait("trot", [0, .5, .5, 0])), (0.5, 0.6))
+
+
+# --------------------------------------------------------------------------- what a walker realises
+# Every built-in creature at three speeds spanning its range (Froude numbers 0.05, 0.2, 0.5), one
+# character from a fresh start; the bars of issue 13, per stride and per foot-frame. Fixed seeds plus
+# fresh ones each session (conftest.fresh_seeds; a seed that ever failed joins FIXED_SEEDS).
+from conftest import fresh_seeds  # noqa: E402
+
+FIXED_SEEDS = (0,)
+FROUDE = (0.05, 0.2, 0.5)
+BARS = {"flat": (0.05, 0.15), "hills": (0.10, 0.25)}  # per-stride error: median, p90
+
+
+def _walk(creature_name, scenario_name, froude, seed, frames=300):
+    from planner._crowd import init_crowd
+    from planner._simulation import simulate
+    from planner._timing import hip_height
+    from scenarios import load_scenario
+    from scenarios._gait_schedule import gait_schedule
+
+    creature = load_creature(creature_name)
+    speed = math.sqrt(froude * GRAVITY * hip_height(creature))
+    scenario = load_scenario(f"{scenario_name}@crowd.speed={speed:.5f}")
+    model, state = init_crowd(scenario, creature, gait_schedule(creature), n_characters=1, seed=seed)
+    return simulate(model, state, frames)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("scenario_name", sorted(BARS))
+@pytest.mark.parametrize("creature_name", ("spider", "ant", "quadruped", "robot5"))
+def test_every_creature_walks_its_speed_range_with_the_stride_law(creature_name, scenario_name):
+    median_bar, p90_bar = BARS[scenario_name]
+    for seed in fresh_seeds(FIXED_SEEDS, 1, salt=hash((creature_name, scenario_name)) % 1000):
+        for froude in FROUDE:
+            s = _walk(creature_name, scenario_name, froude, seed)
+            where = f"{creature_name} on {scenario_name} at Fr {froude}, seed {seed}: {s}"
+            goal = min(s.speed_asked, s.speed_cap or math.inf)
+            assert s.strides_measured >= 10, where
+            assert s.stride_rel_error_median <= median_bar, where
+            assert s.stride_rel_error_p90 <= p90_bar, where
+            if scenario_name == "flat":
+                assert s.speed_reached >= 0.95 * goal, where
+            assert s.ik_residual_p95_m <= 2e-3, where
+            assert s.max_stance_slip_m <= 1e-3, where
+            assert s.leg_crossings == 0, where
+
+
+def test_duty_factor_falls_with_speed_and_the_quadruped_trots_when_fast():
+    slow, fast = _walk("quadruped", "flat", 0.05, 0), _walk("quadruped", "flat", 0.5, 0)
+    assert slow.duty_factor_mean > fast.duty_factor_mean >= 0.5 - 1e-9  # biomechanics: walk DF > 0.5
+    assert slow.gait_fractions["quadruped-walk"] == 1.0
+    assert fast.gait_fractions["quadruped-trot"] > 0.9
