@@ -75,8 +75,8 @@ def _wavefront_grids(maps, requests, weights, config):
         sr, sc = m.frame.world_to_cell(q.source[0], q.source[2])
         source = int((sr - r0 + 1) * wp + (sc - c0 + 1))
         cands = footprint_candidates(code, elev_dil, raw, r0, c0, hp, wp, m.frame.origin_x, m.frame.origin_z, cell,
-                                     source, q.preferred[0], q.preferred[1], config.search_radius_m, q.hip[0],
-                                     q.hip[1], q.reach_xz, q.other_legs, w)[0]
+                                     source, q.source[0], q.source[2], q.preferred[0], q.preferred[1],
+                                     config.search_radius_m, q.hip[0], q.hip[1], q.reach_xz, q.other_legs, w)[0]
         if cands.size == 0:
             continue
         n = hp * wp

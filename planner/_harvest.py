@@ -45,7 +45,7 @@ class FootHarvest:
     """All couples of one foot. n candidates (the search's order), S slices."""
 
     cand_cells: np.ndarray  # (n, 2) local (row, col)
-    cand_xyz: np.ndarray  # (n, 3) target points (cell centre, dilated elevation)
+    cand_xyz: np.ndarray  # (n, 3) target points (continuous footprint in the cell, dilated elevation)
     cand_features: np.ndarray  # (n, 5) FEATURES
     cand_terms: np.ndarray  # (n, 5) footprint goodnesses (the runtime's)
     cand_scores: np.ndarray  # (n,) footprint scores (the runtime's)
@@ -108,6 +108,7 @@ class Harvest:
     d_ref: np.ndarray  # (F,) m
     cand_mask: np.ndarray  # (F, K) bool
     cand_xyz: np.ndarray  # (F, K, 3)
+    cand_centre_xz: np.ndarray  # (F, K, 2) centres of the candidate cells (a footprint is its cell's point nearest P)
     cand_features: np.ndarray  # (F, K, 5) FEATURES
     cand_terms: np.ndarray  # (F, K, 5)
     cand_scores: np.ndarray  # (F, K)
@@ -161,15 +162,18 @@ def _harvest_batch(batch, weights, config, out, cs, ls, kinds, state, model, met
             chosen = _row_of(foot.cand_cells, foot.levels.size, best[1], int(best[3]))
         crowd = (-1, -1)
         if out.valid[i]:
-            # The target is a cell centre: its local (row, col) is exact after flooring.
-            rc = np.floor((out.target[i, [2, 0]] - batch.origins[ch, ::-1]) / config.cell_size).astype(np.int64)
-            crowd = _row_of(foot.cand_cells, foot.levels.size, rc, int(out.slice_index[i]))
+            # The target is a candidate's continuous footprint, computed by the same kernel: equal bit for bit.
+            hit = np.flatnonzero((foot.cand_xyz[:, 0] == out.target[i, 0]) & (foot.cand_xyz[:, 2] == out.target[i, 2]))
+            if hit.size != 1:
+                raise RuntimeError("harvest: the search's couple is not among the harvested ones")
+            crowd = _row_of(foot.cand_cells, foot.levels.size, foot.cand_cells[hit[0]], int(out.slice_index[i]))
         c, leg = int(cs[i]), int(ls[i])
         rows.append(dict(
             meta, frame=state.frame, character=c, leg=leg, kind=int(kinds[i]), leg_height=model.leg_height,
             speed=float(state.speed[c]), forward=(math.cos(state.heading[c]), math.sin(state.heading[c])),
             relative_swing=float(lengths[c, leg] / np.mean(lengths[c])), source=batch.sources[i].copy(),
-            preferred=batch.preferred[i].copy(), cell_size=config.cell_size, foot=foot, chosen=chosen,
+            preferred=batch.preferred[i].copy(), cell_size=config.cell_size, origin=batch.origins[ch].copy(), foot=foot,
+            chosen=chosen,
             chosen_scores=best[5].copy(), chosen_terms=best[6].copy(), chosen_raw=best[7].copy(), crowd_choice=crowd))
 
 
@@ -179,6 +183,7 @@ def _pack(rows: list[dict], creatures, scenarios, weights: np.ndarray, timing: n
     s = max([r["foot"].levels.size for r in rows] + [1])
     cand_mask = np.zeros((f, k), np.bool_)
     cand_xyz = np.zeros((f, k, 3))
+    cand_centre_xz = np.zeros((f, k, 2))
     cand_features = np.zeros((f, k, N_FEATURES))
     cand_terms = np.zeros((f, k, N_FOOTPRINT_TERMS))
     cand_scores = np.zeros((f, k))
@@ -191,6 +196,7 @@ def _pack(rows: list[dict], creatures, scenarios, weights: np.ndarray, timing: n
         n, m = h.cand_scores.size, h.levels.size
         cand_mask[i, :n] = True
         cand_xyz[i, :n] = h.cand_xyz
+        cand_centre_xz[i, :n] = r["origin"] + (h.cand_cells[:, ::-1] + 0.5) * r["cell_size"]
         cand_features[i, :n] = h.cand_features
         cand_terms[i, :n] = h.cand_terms
         cand_scores[i, :n] = h.cand_scores
@@ -210,6 +216,7 @@ def _pack(rows: list[dict], creatures, scenarios, weights: np.ndarray, timing: n
         relative_swing=col("relative_swing"), source=col("source").reshape(f, 3),
         preferred=col("preferred").reshape(f, 2), cell_size=col("cell_size"),
         d_ref=np.array([r["foot"].d_ref for r in rows]), cand_mask=cand_mask, cand_xyz=cand_xyz,
+        cand_centre_xz=cand_centre_xz,
         cand_features=cand_features, cand_terms=cand_terms, cand_scores=cand_scores, couple_mask=couple_mask,
         couple_raw=couple_raw, couple_terms=couple_terms, couple_scores=couple_scores,
         chosen=col("chosen", np.int64).reshape(f, 2), chosen_scores=col("chosen_scores").reshape(f, 3),

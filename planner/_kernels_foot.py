@@ -47,6 +47,8 @@ SIZE_INCREASE = 2  # free, but a foot centred here would touch a forbidden cell
 OTHER_LEG = 3  # another leg's projection or another foot
 PAD = 4  # the padding ring around the ROI
 
+MIN_STEP_CELLS = 1e-3
+"""A candidate footprint closer to the foot than this (cells) is no step (and no path)."""
 MAX_SLICES = 12
 MAX_DENSE = 1024  # samples of one path; a longer path is refused
 DENSE_SPACING = 0.35  # target spacing of dense samples, in cells
@@ -216,11 +218,26 @@ def weighted_mean(w, terms, lo, hi):
 
 
 @nb.njit(cache=True)
-def footprint_candidates(code, elev_dil, elev_raw, r0, c0, hp, wp, origin_x, origin_z, cell, source_p, pref_x, pref_z,
-                         radius, hip_x, hip_z, reach_xz, other_legs, w):
+def footprint_point(cx, cz, cell, pref_x, pref_z):
+    """The footprint of the cell centred at (cx, cz): the point of its closed square nearest to
+    the preferred footprint (so the preferred footprint itself when it lies in the cell). Strides
+    are then continuous, not multiples of the cell (the foot-shape dilation holds for a foot
+    centred anywhere in the cell, :func:`planner._kernels_geometry.foot_offsets`)."""
+    h = 0.5 * cell
+    return min(max(pref_x, cx - h), cx + h), min(max(pref_z, cz - h), cz + h)
+
+
+@nb.njit(cache=True)
+def footprint_candidates(code, elev_dil, elev_raw, r0, c0, hp, wp, origin_x, origin_z, cell, source_p, source_x,
+                         source_z, pref_x, pref_z, radius, hip_x, hip_z, reach_xz, other_legs, w):
     """Potential footprints (§5.1): free cells in the disc, within reach, no leg crossing.
 
-    Returns (cells, terms (n, 5), scores, features (n, 5)) sorted by descending
+    The footprint of a candidate cell is a continuous point: the point of the cell's square
+    nearest to the preferred footprint (the preferred footprint itself when its own cell is a
+    candidate), see :func:`footprint_point`; reach, leg crossing, distance and leg gap are
+    measured at that point (roughness, slope and proximity are the cell's).
+
+    Returns (cells, terms (n, 5), scores, features (n, 5), points (n, 2)) sorted by descending
     footprint score, ties by ascending padded index (deterministic).
     """
     n = hp * wp
@@ -239,15 +256,19 @@ def footprint_candidates(code, elev_dil, elev_raw, r0, c0, hp, wp, origin_x, ori
     scores = np.empty(n, dtype=np.float64)
     buf = np.empty(N_TERMS, dtype=np.float64)
     feat = np.empty(N_FEATURES, dtype=np.float64)
+    points = np.empty((n, 2), dtype=np.float64)
     m = 0
     for rr in range(1, hp - 1):
         for cc in range(1, wp - 1):
             p = rr * wp + cc
             if code[p] != FREE or p == source_p:
                 continue
-            x, z = cell_centre(r0 - 1 + rr, c0 - 1 + cc, origin_x, origin_z, cell)
-            if math.hypot(x - pref_x, z - pref_z) > radius:
-                continue
+            cx, cz = cell_centre(r0 - 1 + rr, c0 - 1 + cc, origin_x, origin_z, cell)
+            if math.hypot(cx - pref_x, cz - pref_z) > radius:
+                continue  # the candidate disc is a set of cells (paper Fig. 13)
+            x, z = footprint_point(cx, cz, cell, pref_x, pref_z)
+            if math.hypot(x - source_x, z - source_z) < MIN_STEP_CELLS * cell:
+                continue  # a foot on a cell border: the neighbour's nearest point may be where it stands
             if math.hypot(x - hip_x, z - hip_z) > reach_xz:
                 continue
             if not footprint_features(p, x, z, elev_dil, elev_raw, prox_dt, wp, pref_x, pref_z, hip_x, hip_z,
@@ -259,9 +280,12 @@ def footprint_candidates(code, elev_dil, elev_raw, r0, c0, hp, wp, origin_x, ori
                 terms[m, k] = buf[k]
                 features[m, k] = feat[k]
             scores[m] = weighted_mean(w, buf, 0, N_FOOTPRINT_TERMS)
+            points[m, 0] = x
+            points[m, 1] = z
             m += 1
     order = np.argsort(-scores[:m], kind="mergesort")
-    return cells[:m][order].copy(), terms[:m][order].copy(), scores[:m][order].copy(), features[:m][order].copy()
+    return (cells[:m][order].copy(), terms[:m][order].copy(), scores[:m][order].copy(), features[:m][order].copy(),
+            points[:m][order].copy())
 
 
 @nb.njit(cache=True)
@@ -360,12 +384,12 @@ def segment_clear(ax, az, bx, bz, passable, source_p, r0, c0, hp, wp, origin_x, 
 
 
 @nb.njit(cache=True)
-def naive_and_kept_points(parent, source_p, target_p, source_x, source_z, passable, r0, c0, hp, wp, origin_x, origin_z,
-                          cell, rows, cols):
+def naive_and_kept_points(parent, source_p, target_p, source_x, source_z, target_x, target_z, passable, r0, c0, hp,
+                          wp, origin_x, origin_z, cell, rows, cols):
     """Naive cells of the wavefront path, refined by line of sight (§4).
 
     Returns the kept points (k, 2) in world x, z: the exact source, the cell
-    centres kept, the target cell centre.
+    centres kept, the exact target point (a continuous footprint inside the target cell).
     """
     count = 1
     p = target_p
@@ -384,6 +408,8 @@ def naive_and_kept_points(parent, source_p, target_p, source_x, source_z, passab
             p = parent[p]
     naive[0, 0] = source_x
     naive[0, 1] = source_z
+    naive[count - 1, 0] = target_x
+    naive[count - 1, 1] = target_z
     kept_idx = np.empty(count, dtype=np.int64)
     kept_idx[0] = 0
     nk = 1
@@ -691,14 +717,15 @@ def path_length_3d(poly, n):
 
 
 @nb.njit(cache=True)
-def couple_metrics_2d(parent, passable, dt, elev_dil, source_p, target_p, source_x, source_y, source_z, target_y,
-                      step_height, r0, c0, hp, wp, origin_x, origin_z, cell, dense, dense_p, rows, cols):
+def couple_metrics_2d(parent, passable, dt, elev_dil, source_p, target_p, source_x, source_y, source_z, target_x,
+                      target_y, target_z, step_height, r0, c0, hp, wp, origin_x, origin_z, cell, dense, dense_p, rows,
+                      cols):
     """The 2D part of a (target, slice) couple: the path from the slice's wavefront tree, its
     2D metrics, and the 2D climb over the elevations under the path (the 3D trajectory stays
     above them, so climb_3d >= climb_2d, and with length_3d >= length_2d, score_3d <= score_2d).
     Returns (n_dense, length_2d, curvature, clearance, climb_2d); n_dense < 2: no path."""
-    kept = naive_and_kept_points(parent, source_p, target_p, source_x, source_z, passable, r0, c0, hp, wp, origin_x,
-                                 origin_z, cell, rows, cols)
+    kept = naive_and_kept_points(parent, source_p, target_p, source_x, source_z, target_x, target_z, passable, r0, c0,
+                                 hp, wp, origin_x, origin_z, cell, rows, cols)
     nd, len2, curv, clear = path_2d(kept, passable, dt, elev_dil, source_p, r0, c0, hp, wp, origin_x, origin_z, cell,
                                     dense, dense_p, rows, cols)
     if nd < 2:

@@ -92,7 +92,8 @@ def foot_setup(elevation, ground, forbidden, origin_x, origin_z, offsets, source
                feet_block_radius, w, cfg, slice_size):
     """ROI maps, potential footprints, slices and d_ref of one foot (shared by the search and the
     harvest). Returns (code, elev_dil, boxh_dil, r0, c0, hp, wp, source_p, cand, cand_terms,
-    cand_scores, cand_features, cand_rc, levels, d_ref)."""
+    cand_scores, cand_features, cand_rc, levels, d_ref, cand_xz) - ``cand_xz`` (n, 2) the
+    continuous footprints (:func:`planner._kernels_foot.footprint_point`)."""
     cell = cfg[C_CELL]
     radius = cfg[C_RADIUS]
     pref_x = preferred[0]
@@ -102,9 +103,9 @@ def foot_setup(elevation, ground, forbidden, origin_x, origin_z, offsets, source
         int(cfg[C_MARGIN]), other_legs, feet_block_radius)
     sr, sc = cell_of(source[0], source[2], origin_x, origin_z, cell)
     source_p = (sr - r0 + 1) * wp + (sc - c0 + 1)
-    cand, cand_terms, cand_scores, cand_features = footprint_candidates(
-        code, elev_dil, elev_raw, r0, c0, hp, wp, origin_x, origin_z, cell, source_p, pref_x, pref_z, radius,
-        hip[0], hip[1], reach_xz, other_legs, w)
+    cand, cand_terms, cand_scores, cand_features, cand_xz = footprint_candidates(
+        code, elev_dil, elev_raw, r0, c0, hp, wp, origin_x, origin_z, cell, source_p, source[0], source[2], pref_x,
+        pref_z, radius, hip[0], hip[1], reach_xz, other_legs, w)
     n_cand = cand.size
     cand_rc = np.empty((n_cand, 2), dtype=np.int64)
     for k in range(n_cand):
@@ -115,7 +116,7 @@ def foot_setup(elevation, ground, forbidden, origin_x, origin_z, offsets, source
     # The length goodness's reference: the source -> preferred distance (at least a cell).
     d_ref = max(math.hypot(pref_x - source[0], pref_z - source[2]), cell)
     return (code, elev_dil, boxh_dil, r0, c0, hp, wp, source_p, cand, cand_terms, cand_scores, cand_features, cand_rc,
-            levels, d_ref)
+            levels, d_ref, cand_xz)
 
 
 @nb.njit(cache=True)
@@ -136,7 +137,7 @@ def plan_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, 
     source_z = source[2]
     counters = np.zeros(N_COUNTERS, dtype=np.int64)
     (code, elev_dil, boxh_dil, r0, c0, hp, wp, source_p, cand, cand_terms, cand_scores, _, cand_rc, levels,
-     d_ref) = foot_setup(elevation, ground, forbidden, origin_x, origin_z, offsets, source, preferred, hip, reach_xz,
+     d_ref, cand_xz) = foot_setup(elevation, ground, forbidden, origin_x, origin_z, offsets, source, preferred, hip, reach_xz,
                          other_legs, feet_block_radius, w, cfg, slice_size)
     n = hp * wp
     n_cand = cand.size
@@ -155,8 +156,7 @@ def plan_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, 
     for k in range(n_cand - 1, -1, -1):
         for t in range(N_FOOTPRINT_TERMS):
             tb[t] = cand_terms[k, t]
-        x, z = cell_centre(cand_rc[k, 0], cand_rc[k, 1], origin_x, origin_z, cell)
-        straight = math.hypot(x - source_x, z - source_z)
+        straight = math.hypot(cand_xz[k, 0] - source_x, cand_xz[k, 1] - source_z)
         for t in range(N_FOOTPRINT_TERMS, N_TERMS):
             tb[t] = 1.0
         tb[N_FOOTPRINT_TERMS] = d_ref / max(straight, d_ref)
@@ -193,7 +193,8 @@ def plan_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, 
             break
         tp = cand[k]
         target_y = elev_dil[tp]
-        tx, tz = cell_centre(cand_rc[k, 0], cand_rc[k, 1], origin_x, origin_z, cell)
+        tx = cand_xz[k, 0]
+        tz = cand_xz[k, 1]
         evaluated_3d = False
         improved = False
         for s in range(n_slices):
@@ -219,7 +220,7 @@ def plan_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, 
             if not math.isfinite(dist[s, tp]):
                 continue
             nd, len2, curv, clear, climb2 = couple_metrics_2d(
-                parent[s], passable[s], dt[s], elev_dil, source_p, tp, source_x, source_y, source_z, target_y,
+                parent[s], passable[s], dt[s], elev_dil, source_p, tp, source_x, source_y, source_z, tx, target_y, tz,
                 step_height, r0, c0, hp, wp, origin_x, origin_z, cell, dense, dense_p, rows, cols)
             if nd < 2:
                 continue
@@ -273,10 +274,9 @@ def plan_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, 
         resample_by_arclength(best_poly, best_n, k_out, trajectory)
         target_rc[0] = cand_rc[best_k, 0]
         target_rc[1] = cand_rc[best_k, 1]
-        tx, tz = cell_centre(target_rc[0], target_rc[1], origin_x, origin_z, cell)
-        target_xyz[0] = tx
+        target_xyz[0] = cand_xz[best_k, 0]
         target_xyz[1] = best_target_y
-        target_xyz[2] = tz
+        target_xyz[2] = cand_xz[best_k, 1]
         scores[SCORE_COUPLE] = best_score
         scores[SCORE_FOOTPRINT] = cand_scores[best_k]
         scores[SCORE_TRAJECTORY] = weighted_mean(w, best_terms, N_FOOTPRINT_TERMS, N_TERMS)
@@ -315,17 +315,16 @@ def harvest_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offset
     source_y = source[1]
     source_z = source[2]
     (code, elev_dil, boxh_dil, r0, c0, hp, wp, source_p, cand, cand_terms, cand_scores, cand_features, cand_rc, levels,
-     d_ref) = foot_setup(elevation, ground, forbidden, origin_x, origin_z, offsets, source, preferred, hip, reach_xz,
+     d_ref, cand_xz) = foot_setup(elevation, ground, forbidden, origin_x, origin_z, offsets, source, preferred, hip, reach_xz,
                          other_legs, feet_block_radius, w, cfg, slice_size)
     n = hp * wp
     n_cand = cand.size
     n_slices = levels.size
     cand_xyz = np.empty((n_cand, 3), dtype=np.float64)
     for k in range(n_cand):
-        x, z = cell_centre(cand_rc[k, 0], cand_rc[k, 1], origin_x, origin_z, cell)
-        cand_xyz[k, 0] = x
+        cand_xyz[k, 0] = cand_xz[k, 0]
         cand_xyz[k, 1] = elev_dil[cand[k]]
-        cand_xyz[k, 2] = z
+        cand_xyz[k, 2] = cand_xz[k, 1]
     couple_valid = np.zeros((n_cand, n_slices), dtype=np.bool_)
     couple_raw = np.zeros((n_cand, n_slices, N_RAW), dtype=np.float64)
     couple_terms = np.zeros((n_cand, n_slices, N_TERMS), dtype=np.float64)
@@ -356,8 +355,8 @@ def harvest_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offset
                 continue
             target_y = elev_dil[tp]
             nd, len2, curv, clear, climb2 = couple_metrics_2d(
-                parent, passable, dt, elev_dil, source_p, tp, source_x, source_y, source_z, target_y, step_height,
-                r0, c0, hp, wp, origin_x, origin_z, cell, dense, dense_p, rows, cols)
+                parent, passable, dt, elev_dil, source_p, tp, source_x, source_y, source_z, cand_xz[k, 0], target_y,
+                cand_xz[k, 1], step_height, r0, c0, hp, wp, origin_x, origin_z, cell, dense, dense_p, rows, cols)
             if nd < 2:
                 continue
             len3, climb3, jerk = couple_metrics_3d(dense, nd, len2, source_y, target_y, step_height,

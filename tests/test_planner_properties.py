@@ -136,8 +136,11 @@ def check_couple(result, query, maps, boxes, inflated):
     np.testing.assert_array_equal(traj[-1], result.target)
     tr, tc = result.target_cell
     assert not maps.forbidden[tr, tc] and not inflated[tr, tc], "footprint on a forbidden or size-increase cell"
-    tx, tz = maps.frame.cell_to_world(tr, tc)
-    assert (tx, tz) == (result.target[0], result.target[2])
+    # A continuous footprint: the point of the target cell nearest the preferred footprint.
+    cx, cz = maps.frame.cell_to_world(tr, tc)
+    half = 0.5 * maps.frame.cell_size
+    px, pz = query.preferred
+    assert (min(max(px, cx - half), cx + half), min(max(pz, cz - half), cz + half)) == (result.target[0], result.target[2])
     half_foot = (0.5 * query.foot_length, 0.5 * query.foot_width)
     for cx, cy, cz, sx, h, sz, yaw, is_forbidden in boxes:
         top = cy + 0.5 * h

@@ -87,7 +87,9 @@ def _mean_metrics(sit, tau):
     @jax.jit
     def f(log_params):
         params = jnp.exp(log_params)
-        metrics = tuning.expected_metrics(params[:n_w], params[n_w:], sit, tau)
+        # Clearance is +inf for a path with nothing blocked around it; cap it (as the fit does) so that
+        # its expectation and derivatives are finite numbers to compare.
+        metrics = tuning.expected_metrics(params[:n_w], params[n_w:], sit, tau, clearance_cap_m=1.0)
         return jnp.stack([jnp.mean(metrics[k]) for k in tuning.PROXY_METRICS])
 
     return f

@@ -35,8 +35,10 @@ foot) is one stride v / f = lambda, symmetric about the rest foot.
 P enters the couple score twice: the distance feature d_k = |x_k - P| of every
 candidate (closeness goodness) and the length goodness's reference
 d_ref = max(|P - source|, cell). The expected step length therefore depends on
-theta through the probabilities only: the candidate positions x_k, the source and
-every other raw number are the harvest's, held fixed. This is a local model, valid
+theta through the probabilities and the continuous footprints: each candidate's
+footprint x_k is its cell's point nearest P (:func:`footprints`, the runtime's
+``footprint_point``), so it follows P inside its cell; the source and every other
+raw number are the harvest's, held fixed. This is a local model, valid
 while P stays well inside the harvested candidate disc (the runtime would re-centre
 the disc on the new P and plan new paths); a fit should re-harvest between
 iterations. The other legs' hips (crossings and gaps) are also held at theta_0.
@@ -95,6 +97,7 @@ class Situations(eqx.Module):
 
     cand_mask: jax.Array  # (F, K) bool
     cand_xz: jax.Array  # (F, K, 2)
+    cand_centre: jax.Array  # (F, K, 2) centres of the candidate cells
     cand_features: jax.Array  # (F, K, 5)
     couple_mask: jax.Array  # (F, K, S) bool
     couple_raw: jax.Array  # (F, K, S, 5)
@@ -127,6 +130,7 @@ def situations_from_harvest(harvest) -> Situations:
         raise ValueError("harvest: features or raw metrics of the wrong width")
     return Situations(
         cand_mask=jnp.asarray(harvest.cand_mask[keep]), cand_xz=f64(harvest.cand_xyz[..., [0, 2]]),
+        cand_centre=f64(harvest.cand_centre_xz),
         cand_features=f64(harvest.cand_features), couple_mask=jnp.asarray(harvest.couple_mask[keep]),
         couple_raw=f64(harvest.couple_raw), source=f64(harvest.source), preferred=f64(harvest.preferred),
         forward=f64(harvest.forward), speed=f64(harvest.speed), leg_height=f64(harvest.leg_height),
@@ -182,11 +186,20 @@ def _norm(dx, dz):
     return jnp.sqrt(jnp.maximum(dx * dx + dz * dz, 1e-300))
 
 
+def footprints(situations: Situations, pref):
+    """(F, K, 2) the candidates' continuous footprints for preferred footprints ``pref`` (F, 2): each
+    cell's point nearest P (planner._kernels_foot.footprint_point); = the harvest's at theta_0."""
+    s = situations
+    half = 0.5 * s.cell_size[:, None, None]
+    return jnp.clip(pref[:, None, :], s.cand_centre - half, s.cand_centre + half)
+
+
 def couple_scores(weights, timing, situations: Situations):
     """(F, K, S) couple scores at weights ``w`` and timing ``theta`` (invalid couples: -inf)."""
     s = situations
     pref = preferred_footprint(timing, s)
-    d = _norm(s.cand_xz[..., 0] - pref[:, None, 0], s.cand_xz[..., 1] - pref[:, None, 1])
+    x = footprints(s, pref)
+    d = _norm(x[..., 0] - pref[:, None, 0], x[..., 1] - pref[:, None, 1])
     features = s.cand_features.at[..., FEAT_DISTANCE].set(d)
     d_ref = jnp.maximum(_norm(pref[:, 0] - s.source[:, 0], pref[:, 1] - s.source[:, 2]), s.cell_size)
     score = couple_score(features[:, :, None, :], s.couple_raw, d_ref[:, None, None], weights)
@@ -228,9 +241,10 @@ def _metrics_under(p, scores, timing, s, clearance_cap_m):
     def expect(values):  # values (F, K, S); invalid couples have p = 0 and are zeroed (no inf * 0)
         return jnp.sum(p * jnp.where(s.couple_mask, values, 0.0), axis=(1, 2))
 
-    step = _norm(s.cand_xz[..., 0] - s.source[:, None, 0], s.cand_xz[..., 1] - s.source[:, None, 2])
-    ahead = ((s.cand_xz[..., 0] - pref[:, None, 0]) * s.forward[:, None, 0]
-             + (s.cand_xz[..., 1] - pref[:, None, 1]) * s.forward[:, None, 1])
+    x = footprints(s, pref)
+    step = _norm(x[..., 0] - s.source[:, None, 0], x[..., 1] - s.source[:, None, 2])
+    ahead = ((x[..., 0] - pref[:, None, 0]) * s.forward[:, None, 0]
+             + (x[..., 1] - pref[:, None, 1]) * s.forward[:, None, 1])
     raw = s.couple_raw
     clearance = raw[..., RAW_CLEARANCE]
     finite = jnp.isfinite(clearance)

@@ -204,11 +204,16 @@ class TuneResult:
 
 
 def check_creature(name: str) -> str:
-    from scenarios import builtin_creature_names
+    """``name`` if it is a built-in creature name or a creature ``.toml`` (one resolver:
+    :func:`scenarios.load_creature`); else one line on ``--creature``."""
+    from scenarios import load_creature
 
-    names = builtin_creature_names()
-    if name not in names:
-        raise InputError("argument", "--creature", f"unknown creature {name!r}; built-ins are: {', '.join(names)}")
+    try:
+        load_creature(name)
+    except InputError as error:
+        if error.file == str(name) and error.field == "creature":  # neither a built-in name nor a file
+            raise InputError("argument", "--creature", f"{name!r}: {error.reason}") from None
+        raise
     return name
 
 
@@ -296,6 +301,7 @@ def _pad_problem(problem, n: int, k: int, s: int):
     forward[f:, 0] = 1.0
     new = Situations(
         cand_mask=jnp.asarray(cand_mask), cand_xz=jnp.asarray(pad(sit.cand_xz, 0.0, [(0, n), (1, k)])),
+        cand_centre=jnp.asarray(pad(sit.cand_centre, 0.0, [(0, n), (1, k)])),
         cand_features=jnp.asarray(pad(sit.cand_features, 0.0, [(0, n), (1, k)])),
         couple_mask=jnp.asarray(couple_mask),
         couple_raw=jnp.asarray(pad(sit.couple_raw, 0.0, [(0, n), (1, k), (2, s)])),
@@ -543,14 +549,15 @@ def tune(config: TuneConfig, out: str | Path, resume: bool = False, progress=Non
 
 def _tune(config: TuneConfig, out, resume, progress, stop_after, write, evaluate, map_tasks, t0) -> TuneResult:
     from planner._presets import preset_dict
-    from scenarios import default_gait_name
+    from scenarios import default_gait_name, load_creature
     from tuning._config import enable_x64
     from tuning._targets import TARGETS_FILE, load_targets
 
     out = check_output(out)
     ckpt = checkpoint_path(out)
     enable_x64()
-    targets = load_targets(creatures=(config.creature,))
+    # Keyed by the creature reference the runs carry (a built-in name, or a creature file).
+    targets = dict(zip((config.creature,), load_targets(creatures=(config.creature,)).values()))
     setup = config.exact_setup()
     say = progress or (lambda *a: None)
     total = config.rounds + 2
@@ -676,7 +683,8 @@ def _tune(config: TuneConfig, out, resume, progress, stop_after, write, evaluate
                    "rounds": state["history"]},
         "summary": summary,
     }
-    preset = preset_dict(config.creature, weights, timing, default_gait_name(config.creature), provenance)
+    creature = load_creature(config.creature)  # a preset names the creature, not its file
+    preset = preset_dict(creature.name, weights, timing, default_gait_name(creature), provenance)
     if write:
         write_text_atomic(out, json.dumps(preset, indent=1, allow_nan=False) + "\n")
     return TuneResult(preset=preset, summary=summary, wall_s=time.perf_counter() - t0)
