@@ -76,7 +76,8 @@ def _wavefront_grids(maps, requests, weights, config):
         source = int((sr - r0 + 1) * wp + (sc - c0 + 1))
         cands = footprint_candidates(code, elev_dil, raw, r0, c0, hp, wp, m.frame.origin_x, m.frame.origin_z, cell,
                                      source, q.source[0], q.source[2], q.preferred[0], q.preferred[1],
-                                     config.search_radius_m, q.hip[0], q.hip[1], q.reach_xz, q.other_legs, w)[0]
+                                     config.search_radius_m, q.hip[0], q.hip[1], q.reach_xz, q.other_legs,
+                                     q.feet_block_radius, w)[0]
         if cands.size == 0:
             continue
         n = hp * wp

@@ -291,7 +291,10 @@ def stance_speed_cap(model: CrowdModel, state: CrowdState) -> np.ndarray:
     the rear end of its leg's stance window until its sector starts (inf: no stance foot near)."""
     g = state.gaits
     frequency = np.maximum(state.stride_frequency, 1e-9)[:, None]
-    until_lift = np.mod(g.disk_start - g.needle[:, None], 1.0) / frequency + 2.0 * model.dt
+    until_lift = np.mod(g.disk_start - g.needle[:, None], 1.0) / frequency + model.dt  # lifts the frame its sector starts
+    # A foot whose sector has started but which has not lifted yet (its plan is pending) lifts as
+    # soon as it can: its next turn is not a cycle away.
+    until_lift = np.where(state.wants_swing | state.sector_missed, model.dt, until_lift)
     d = state.feet[..., [0, 2]] - state.pelvis[:, None, [0, 2]]
     forward = d[..., 0] * np.cos(state.heading)[:, None] + d[..., 1] * np.sin(state.heading)[:, None]
     room = forward - state.feet_spacing[:, None] * model.stance_window[None, :, 0]

@@ -218,6 +218,17 @@ def weighted_mean(w, terms, lo, hi):
 
 
 @nb.njit(cache=True)
+def _clear_of_other_feet(x, z, other_legs, leg_gap, feet_block_radius):
+    """A footprint at (x, z) keeps ``feet_block_radius`` from every other leg (hip -> foot) and foot."""
+    if leg_gap < feet_block_radius:
+        return False
+    for j in range(other_legs.shape[0]):
+        if math.hypot(x - other_legs[j, 2], z - other_legs[j, 3]) <= feet_block_radius:
+            return False
+    return True
+
+
+@nb.njit(cache=True)
 def footprint_point(cx, cz, cell, pref_x, pref_z):
     """The footprint of the cell centred at (cx, cz): the point of its closed square nearest to
     the preferred footprint (so the preferred footprint itself when it lies in the cell). Strides
@@ -229,7 +240,7 @@ def footprint_point(cx, cz, cell, pref_x, pref_z):
 
 @nb.njit(cache=True)
 def footprint_candidates(code, elev_dil, elev_raw, r0, c0, hp, wp, origin_x, origin_z, cell, source_p, source_x,
-                         source_z, pref_x, pref_z, radius, hip_x, hip_z, reach_xz, other_legs, w):
+                         source_z, pref_x, pref_z, radius, hip_x, hip_z, reach_xz, other_legs, feet_block_radius, w):
     """Potential footprints (§5.1): free cells in the disc, within reach, no leg crossing.
 
     The footprint of a candidate cell is a continuous point: the point of the cell's square
@@ -261,7 +272,10 @@ def footprint_candidates(code, elev_dil, elev_raw, r0, c0, hp, wp, origin_x, ori
     for rr in range(1, hp - 1):
         for cc in range(1, wp - 1):
             p = rr * wp + cc
-            if code[p] != FREE or p == source_p:
+            # A cell touched by another leg's projection is a candidate too when the continuous
+            # footprint in it keeps a foot's room from every other leg and foot (checked below):
+            # blocking whole 7 cm cells moved feet a cell away from where they belong.
+            if (code[p] != FREE and code[p] != OTHER_LEG) or p == source_p:
                 continue
             cx, cz = cell_centre(r0 - 1 + rr, c0 - 1 + cc, origin_x, origin_z, cell)
             if math.hypot(cx - pref_x, cz - pref_z) > radius:
@@ -273,6 +287,9 @@ def footprint_candidates(code, elev_dil, elev_raw, r0, c0, hp, wp, origin_x, ori
                 continue
             if not footprint_features(p, x, z, elev_dil, elev_raw, prox_dt, wp, pref_x, pref_z, hip_x, hip_z,
                                       other_legs, cell, feat):
+                continue
+            if code[p] == OTHER_LEG and not _clear_of_other_feet(x, z, other_legs, feat[FEAT_LEG_GAP],
+                                                                   feet_block_radius):
                 continue
             footprint_goodness(w, feat, buf)
             cells[m] = p
@@ -724,10 +741,15 @@ def couple_metrics_2d(parent, passable, dt, elev_dil, source_p, target_p, source
     2D metrics, and the 2D climb over the elevations under the path (the 3D trajectory stays
     above them, so climb_3d >= climb_2d, and with length_3d >= length_2d, score_3d <= score_2d).
     Returns (n_dense, length_2d, curvature, clearance, climb_2d); n_dense < 2: no path."""
+    # A goal-only target cell (next to another leg, see footprint_candidates) is passable for
+    # the path that ends in it, and only for that path.
+    was = passable[target_p]
+    passable[target_p] = 1
     kept = naive_and_kept_points(parent, source_p, target_p, source_x, source_z, target_x, target_z, passable, r0, c0,
                                  hp, wp, origin_x, origin_z, cell, rows, cols)
     nd, len2, curv, clear = path_2d(kept, passable, dt, elev_dil, source_p, r0, c0, hp, wp, origin_x, origin_z, cell,
                                     dense, dense_p, rows, cols)
+    passable[target_p] = was
     if nd < 2:
         return nd, 0.0, 0.0, 0.0, 0.0
     ground_top = -np.inf

@@ -105,7 +105,7 @@ def foot_setup(elevation, ground, forbidden, origin_x, origin_z, offsets, source
     source_p = (sr - r0 + 1) * wp + (sc - c0 + 1)
     cand, cand_terms, cand_scores, cand_features, cand_xz = footprint_candidates(
         code, elev_dil, elev_raw, r0, c0, hp, wp, origin_x, origin_z, cell, source_p, source[0], source[2], pref_x,
-        pref_z, radius, hip[0], hip[1], reach_xz, other_legs, w)
+        pref_z, radius, hip[0], hip[1], reach_xz, other_legs, feet_block_radius, w)
     n_cand = cand.size
     cand_rc = np.empty((n_cand, 2), dtype=np.int64)
     for k in range(n_cand):

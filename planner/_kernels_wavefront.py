@@ -108,8 +108,11 @@ def wavefront(passable, cost_factor, wp, source, cell, stop_cells, dist, parent)
     move needs both cells it passes between to be passable (no corner cutting), so
     the straight segment between the two centres stays in passable cells. The
     source is expanded even if it is not passable (a foot may stand on a cell that
-    became blocked). Stops as soon as every cell of ``stop_cells`` is settled (or
-    nothing is left to expand). Returns the number of cells expanded.
+    became blocked). A stop cell that is not passable is a goal only: it is reached
+    (orthogonally, or diagonally between passable cells) but never expanded, so no path
+    passes through it (a footprint next to another leg, planner._kernels_foot). Stops as
+    soon as every cell of ``stop_cells`` is settled (or nothing is left to expand).
+    Returns the number of cells expanded.
 
     ``dist`` (inf = not reached) and ``parent`` (-1 = none) are filled in place.
     """
@@ -143,9 +146,11 @@ def wavefront(passable, cost_factor, wp, source, cell, stop_cells, dist, parent)
             remaining -= 1
             if remaining == 0:
                 break
+        if not passable[p] and p != source:
+            continue  # a goal-only cell
         for k in range(8):
             q = p + flat[k]
-            if not passable[q] or settled[q]:
+            if (not passable[q] and not is_stop[q]) or settled[q]:
                 continue
             if dr[k] != 0 and dc[k] != 0:
                 if not passable[p + dr[k] * wp] or not passable[p + dc[k]]:

@@ -37,7 +37,7 @@ WINDOW_SAMPLES = 161
 """Forward positions sampled per leg and height when measuring a window."""
 WINDOW_HEIGHTS = (-0.05, 0.0, 0.05)
 """Foot heights (fractions of the standing height, relative to flat ground) the window must reach at."""
-CENTRE_SLACK = 0.25
+CENTRE_SLACK = 0.1
 """Fraction of a window's free room (its length less the sweep) kept clear at each end of a sweep."""
 REACH_TOLERANCE = 1e-4
 """A target counts as reached when the IK residual is below this (m)."""
@@ -109,10 +109,10 @@ def stance_centres(rest_forward: np.ndarray, windows: np.ndarray, sweep: np.ndar
     >>> import numpy as np
     >>> stance_centres(np.array([0.05, 0.0]), np.array([[-0.3, 0.3], [-0.1, 0.1]]), np.array([0.1, 0.3]))
     array([0.05, 0.  ])
-    >>> stance_centres(np.array([-0.28]), np.array([[-0.3, 0.3]]), np.array([0.1]))  # -0.3 + 0.05 + 0.125
-    array([-0.125])
+    >>> stance_centres(np.array([-0.28]), np.array([[-0.3, 0.3]]), np.array([0.1]))  # -0.3 + 0.05 + 0.05
+    array([-0.2])
     """
-    # Keep a quarter of the free room at each end when the window allows it: a stance can last
+    # Keep a tenth of the free room at each end when the window allows it: a stance can last
     # longer than planned (a gait change moving the foot's sector, a late landing).
     slack = CENTRE_SLACK * np.maximum(windows[..., 1] - windows[..., 0] - sweep, 0.0)
     lo = windows[..., 0] + 0.5 * sweep + slack

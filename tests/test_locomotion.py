@@ -65,9 +65,9 @@ def test_stance_centres_keep_the_sweep_inside_the_window():
     windows = np.array([[-0.3, 0.3], [-0.3, 0.3], [-0.1, 0.1], [0.0, 0.2]])
     rest = np.array([0.0, -0.28, 0.0, 0.19])
     sweep = np.array([0.2, 0.2, 0.3, 0.1])
-    # free room 0.4 -> slack 0.1 at each end: centre in [-0.3 + 0.1 + 0.1, 0.3 - 0.1 - 0.1] = [-0.1, 0.1]
-    # a sweep longer than its window: the window's middle; free room 0.1 -> slack 0.025: [0.075, 0.125]
-    np.testing.assert_allclose(stance_centres(rest, windows, sweep), [0.0, -0.1, 0.0, 0.125])
+    # free room 0.4 -> slack 0.04 at each end: centre in [-0.3 + 0.1 + 0.04, 0.3 - 0.1 - 0.04] = [-0.16, 0.16]
+    # a sweep longer than its window: the window's middle; free room 0.1 -> slack 0.01: [0.06, 0.14]
+    np.testing.assert_allclose(stance_centres(rest, windows, sweep), [0.0, -0.16, 0.0, 0.14])
 
 
 def test_the_speed_cap_is_where_the_least_duty_factor_just_fits():
