@@ -43,6 +43,21 @@ REACH_TOLERANCE = 1e-4
 """A target counts as reached when the IK residual is below this (m)."""
 
 
+_CACHE: dict = {}
+
+
+def _cached(kind: str, creature, rest_body, hips_body, legs, compute):
+    """Windows and steps depend only on the legs' geometry: computed once per geometry (each costs a
+    few thousand IK solves), then shared by every crowd of that creature."""
+    key = (kind, creature.name, float(creature.standing_height), np.asarray(creature.leg_reach).tobytes(),
+           rest_body.tobytes(), hips_body.tobytes(), legs.segment_lengths.tobytes(), legs.limits.tobytes(),
+           legs.rest_azimuths.tobytes(), np.asarray(legs.azimuth_limits).tobytes())
+    if key not in _CACHE:
+        _CACHE[key] = compute()
+    value = _CACHE[key]
+    return value.copy() if isinstance(value, np.ndarray) else value
+
+
 def stance_windows(creature, rest_body: np.ndarray, hips_body: np.ndarray, legs) -> np.ndarray:
     """(L, 2) stance window ``[lo, hi]`` of every leg, in body-forward metres from the pelvis.
 
@@ -64,6 +79,13 @@ def stance_windows(creature, rest_body: np.ndarray, hips_body: np.ndarray, legs)
         height of :data:`WINDOW_HEIGHTS`, shrunk by :data:`WINDOW_MARGIN`. A leg that cannot
         reach its own rest foot gets the one-point window ``[rest, rest]``.
     """
+    rest_body = np.ascontiguousarray(rest_body, dtype=np.float64)
+    hips_body = np.ascontiguousarray(hips_body, dtype=np.float64)
+    return _cached("windows", creature, rest_body, hips_body, legs,
+                   lambda: _stance_windows(creature, rest_body, hips_body, legs))
+
+
+def _stance_windows(creature, rest_body, hips_body, legs) -> np.ndarray:
     from planner._ik import solve_legs
 
     n_legs = rest_body.shape[0]
@@ -79,7 +101,7 @@ def stance_windows(creature, rest_body: np.ndarray, hips_body: np.ndarray, legs)
         leg = np.repeat(np.arange(n_legs), k)
         result = solve_legs(hips_body[leg], np.broadcast_to(np.eye(3), (leg.size, 3, 3)), legs.rest_azimuths[leg],
                             legs.segment_lengths[leg], legs.limits[leg], legs.azimuth_limits[leg], targets,
-                            max_iterations=48, restarts=8, parallel=False)
+                            max_iterations=48, restarts=8, parallel=True)
         reached &= (result.residual < REACH_TOLERANCE).reshape(n_legs, k)
     windows = np.repeat(rest_body[:, 0:1], 2, axis=1).astype(np.float64)
     middle = k // 2
@@ -168,6 +190,13 @@ def highest_step(creature, rest_body: np.ndarray, hips_body: np.ndarray, legs) -
 
     A safe box taller than this counts as forbidden for the creature (issue 14: an ant that walks
     onto a crate three times its height cannot walk on)."""
+    rest_body = np.ascontiguousarray(rest_body, dtype=np.float64)
+    hips_body = np.ascontiguousarray(hips_body, dtype=np.float64)
+    return _cached("step", creature, rest_body, hips_body, legs,
+                   lambda: _highest_step(creature, rest_body, hips_body, legs))
+
+
+def _highest_step(creature, rest_body, hips_body, legs) -> float:
     from planner._ik import solve_legs
 
     n_legs = rest_body.shape[0]
@@ -178,7 +207,7 @@ def highest_step(creature, rest_body: np.ndarray, hips_body: np.ndarray, legs) -
     leg = np.repeat(np.arange(n_legs), rises.size)
     result = solve_legs(hips_body[leg], np.broadcast_to(np.eye(3), (leg.size, 3, 3)), legs.rest_azimuths[leg],
                         legs.segment_lengths[leg], legs.limits[leg], legs.azimuth_limits[leg], targets,
-                        max_iterations=48, restarts=8, parallel=False)
+                        max_iterations=48, restarts=8, parallel=True)
     reached = (result.residual < REACH_TOLERANCE).reshape(n_legs, rises.size)
     best = height
     for i in range(n_legs):
