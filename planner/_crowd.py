@@ -864,7 +864,8 @@ def _too_tall_forbidden(obstacles, highest: float):
 
 
 def _initial_feet(model: CrowdModel, positions, headings):
-    """Rest feet on cell centres of the world raster, resting on the highest point under the foot."""
+    """Rest feet exactly at their rest positions (footprints are continuous points), resting on the
+    highest point of the world raster under the foot (its cell and the 8 around it)."""
     r = model.raster
     fx, fz = _rot_xz(headings[:, None], model.rest_body[None, :, 0], model.rest_body[None, :, 1])
     fx = fx + positions[:, None, 0]
@@ -872,12 +873,11 @@ def _initial_feet(model: CrowdModel, positions, headings):
     rows, cols = r.frame.world_to_cell(fx, fz)
     rows = np.clip(rows, 1, r.frame.n_rows - 2)
     cols = np.clip(cols, 1, r.frame.n_cols - 2)
-    cx, cz = r.frame.cell_to_world(rows, cols)
     top = np.full(rows.shape, -np.inf)
     for dr in (-1, 0, 1):
         for dc in (-1, 0, 1):
             top = np.maximum(top, r.static_top[rows + dr, cols + dc])
-    return np.stack([cx, top, cz], axis=-1)
+    return np.stack([fx, top, fz], axis=-1)
 
 
 # ----------------------------------------------------------------------------- the frame
