@@ -286,18 +286,23 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
         fb[idx] -= move
 
 
+def stance_room(model: CrowdModel, state: CrowdState) -> np.ndarray:
+    """(C, L) m: how far each foot is in front of the rear end of its leg's stance window."""
+    d = state.feet[..., [0, 2]] - state.pelvis[:, None, [0, 2]]
+    forward = d[..., 0] * np.cos(state.heading)[:, None] + d[..., 1] * np.sin(state.heading)[:, None]
+    return forward - state.feet_spacing[:, None] * model.stance_window[None, :, 0]
+
+
 def stance_speed_cap(model: CrowdModel, state: CrowdState) -> np.ndarray:
     """(C,) the fastest each body may move this frame so that every stance foot stays in front of
     the rear end of its leg's stance window until its sector starts (inf: no stance foot near)."""
+    room = stance_room(model, state)
     g = state.gaits
     frequency = np.maximum(state.stride_frequency, 1e-9)[:, None]
     until_lift = np.mod(g.disk_start - g.needle[:, None], 1.0) / frequency + model.dt  # lifts the frame its sector starts
     # A foot whose sector has started but which has not lifted yet (its plan is pending) lifts as
     # soon as it can: its next turn is not a cycle away.
     until_lift = np.where(state.wants_swing | state.sector_missed, model.dt, until_lift)
-    d = state.feet[..., [0, 2]] - state.pelvis[:, None, [0, 2]]
-    forward = d[..., 0] * np.cos(state.heading)[:, None] + d[..., 1] * np.sin(state.heading)[:, None]
-    room = forward - state.feet_spacing[:, None] * model.stance_window[None, :, 0]
     cap = np.where(state.in_stance, np.maximum(room, 0.0) / until_lift, np.inf)
     return cap.min(axis=1)
 
@@ -427,7 +432,9 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, fre
     kinds[state.wants_swing & state.in_stance] = 1
     far = np.hypot(state.feet[..., 0] - hips[..., 0], state.feet[..., 2] - hips[..., 2]) > _reach_xz(model)[None, :]
     cannot_follow = _stance_unreachable_ahead(model, state, hips, frequency)
-    far |= cannot_follow
+    # A stance foot at the rear end of its window steps now: the body cannot move on without it
+    # (stance_speed_cap holds the body back), and its sector may be a cycle away.
+    far |= cannot_follow | (stance_room(model, state) <= 0.0)
     centres, sizes, yaws, forbidden, moving = boxes
     threatened = np.zeros(state.in_stance.shape, dtype=np.bool_)
     invalid = np.zeros(state.in_stance.shape, dtype=np.bool_)

@@ -172,6 +172,11 @@ def test_a_feet_spacing_change_replans_swinging_feet_and_narrows_the_stance():
     for _ in range(40):
         step(model, state)
     assert spread() < 0.9 * before
+    # ... and walks on: a stance foot left behind its narrower stance window steps (it froze the
+    # body for good when only the needle could lift it and the needle stood still with the body).
+    for _ in range(30):
+        step(model, state)
+    assert state.speed[0] > 0.5 * state.desired_speed[0]
 
 
 def test_a_hold_lowers_the_speed_limit_and_a_step_begun_standing_takes_the_walks_swing_time():
