@@ -290,12 +290,17 @@ def stance_room(model: CrowdModel, state: CrowdState) -> np.ndarray:
     """(C, L) m: how far each foot is in front of the rear end of its leg's stance window."""
     d = state.feet[..., [0, 2]] - state.pelvis[:, None, [0, 2]]
     forward = d[..., 0] * np.cos(state.heading)[:, None] + d[..., 1] * np.sin(state.heading)[:, None]
-    return forward - state.feet_spacing[:, None] * model.stance_window[None, :, 0]
+    return forward - model.stance_window[None, :, 0]
 
 
 def stance_speed_cap(model: CrowdModel, state: CrowdState) -> np.ndarray:
     """(C,) the fastest each body may move this frame so that every stance foot stays in front of
     the rear end of its leg's stance window until its sector starts (inf: no stance foot near)."""
+    return leg_speed_caps(model, state).min(axis=1)
+
+
+def leg_speed_caps(model: CrowdModel, state: CrowdState) -> np.ndarray:
+    """(C, L) the fastest the body may move for each stance foot (inf for swinging feet)."""
     room = stance_room(model, state)
     g = state.gaits
     frequency = np.maximum(state.stride_frequency, 1e-9)[:, None]
@@ -303,8 +308,7 @@ def stance_speed_cap(model: CrowdModel, state: CrowdState) -> np.ndarray:
     # A foot whose sector has started but which has not lifted yet (its plan is pending) lifts as
     # soon as it can: its next turn is not a cycle away.
     until_lift = np.where(state.wants_swing | state.sector_missed, model.dt, until_lift)
-    cap = np.where(state.in_stance, np.maximum(room, 0.0) / until_lift, np.inf)
-    return cap.min(axis=1)
+    return np.where(state.in_stance, np.maximum(room, 0.0) / until_lift, np.inf)
 
 
 def stage_gait(model: CrowdModel, state: CrowdState):
@@ -434,7 +438,10 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, fre
     cannot_follow = _stance_unreachable_ahead(model, state, hips, frequency)
     # A stance foot at the rear end of its window steps now: the body cannot move on without it
     # (stance_speed_cap holds the body back), and its sector may be a cycle away.
-    far |= cannot_follow | (stance_room(model, state) <= 0.0)
+    # A stance foot that holds the body under half its goal speed (stance_speed_cap) steps now too:
+    # waiting for its sector, with the body slow and the needle slower, would freeze the walk.
+    goal = np.minimum(state.desired_speed, state.speed_limit)[:, None]
+    far |= cannot_follow | (stance_room(model, state) <= 0.0) | (leg_speed_caps(model, state) < 0.5 * goal)
     centres, sizes, yaws, forbidden, moving = boxes
     threatened = np.zeros(state.in_stance.shape, dtype=np.bool_)
     invalid = np.zeros(state.in_stance.shape, dtype=np.bool_)
@@ -591,7 +598,7 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     from planner._workspace import stance_centres
 
     sweep = travel(v, goal, model.controller.acceleration, t_swing + t_stance) - travel_swing
-    centre = stance_centres(spacing * model.rest_body[ls, 0], spacing[:, None] * model.stance_window[ls], sweep)
+    centre = stance_centres(spacing * model.rest_body[ls, 0], model.stance_window[ls], sweep)
     rx, rz = _rot_xz(heading, centre, spacing * model.rest_body[ls, 1])
     preferred = pred + np.stack([rx, rz], axis=1) + fwd * (0.5 * sweep)[:, None]
     hx, hz = _rot_xz(heading, model.hips_body[ls, 0], model.hips_body[ls, 2])
