@@ -27,9 +27,20 @@ def _raster(scenario, creature):
     return _rasters[scenario.name, cell]
 
 
+# Found by the counters on the rendered pose (planner._counters), not fixed yet (issue 13/20, open):
+# on hills a spider's stance foot slips by up to 4 mm where the IK cannot follow it over a rise, and
+# a quadruped's knees cross once in a while. Strict: when they are fixed, these runs must pass.
+KNOWN_DEFECTS = {
+    ("spider", "hills"): "stance slip up to 4 mm on hills (IK cannot follow over a rise)",
+    ("quadruped", "hills"): "rendered leg crossings on hills (the knees fold across)",
+}
+
+
 @pytest.mark.parametrize("scenario_name", builtin_scenario_names())
 @pytest.mark.parametrize("creature_name", builtin_creature_names())
-def test_seeded_runs_are_clean(scenario_name, creature_name):
+def test_seeded_runs_are_clean(scenario_name, creature_name, request):
+    if (creature_name, scenario_name) in KNOWN_DEFECTS:
+        request.applymarker(pytest.mark.xfail(strict=True, reason=KNOWN_DEFECTS[creature_name, scenario_name]))
     scenario = load_scenario(scenario_name)
     creature = load_creature(creature_name)
     gait = load_gait(default_gait_name(creature_name), creature)
