@@ -288,8 +288,10 @@ def footprint_candidates(code, elev_dil, elev_raw, r0, c0, hp, wp, origin_x, ori
             if not footprint_features(p, x, z, elev_dil, elev_raw, prox_dt, wp, pref_x, pref_z, hip_x, hip_z,
                                       other_legs, cell, feat):
                 continue
-            if code[p] == OTHER_LEG and not _clear_of_other_feet(x, z, other_legs, feat[FEAT_LEG_GAP],
-                                                                   feet_block_radius):
+            # ... only the cell of the preferred footprint itself (the one a blocked cell costs most):
+            # opening every such cell doubled the candidates and the planning cost.
+            if code[p] == OTHER_LEG and (x != pref_x or z != pref_z or not _clear_of_other_feet(
+                    x, z, other_legs, feat[FEAT_LEG_GAP], feet_block_radius)):
                 continue
             footprint_goodness(w, feat, buf)
             cells[m] = p
