@@ -142,8 +142,15 @@ def test_soft_selection_tends_to_the_hard_choice_as_tau_goes_to_zero(situations,
     hard_tied = tuning._proxies._metrics_under(jnp.asarray(selection), jnp.asarray(scores.reshape(selection.shape)),
                                                timing, sit, jnp.inf)
     hard = tuning.hard_metrics(w, timing, sit)
+    # Ties whose couples differ in a metric the score saturates on (two slices, both clearances
+    # beyond clearance_ref_m) are shared by the softmax but not by the first-maximum pick: compare
+    # the situations whose tied couples agree on every raw metric.
+    raw = np.asarray(sit.couple_raw).reshape(sit.n_situations, -1, np.asarray(sit.couple_raw).shape[-1])
+    same = np.array([np.unique(raw[i][tied[i]], axis=0).shape[0] == 1 for i in range(sit.n_situations)])
+    assert same.mean() > 0.9
     for key in tuning.PROXY_METRICS:
-        np.testing.assert_allclose(np.asarray(hard[key]), np.asarray(hard_tied[key]), rtol=LIMIT_RTOL, atol=0, err_msg=key)
+        np.testing.assert_allclose(np.asarray(hard[key])[same], np.asarray(hard_tied[key])[same], rtol=LIMIT_RTOL,
+                                   atol=0, err_msg=key)
     rest = np.where(tied, -np.inf, scores).max(axis=1)
     gaps = (top[:, 0] - rest)[np.isfinite(rest)]
     taus = (1e-1, 1e-2, 1e-3, 1e-4, TIE_TAU_FRACTION * gaps.min())
