@@ -46,21 +46,23 @@ def run_main_job(scenario_name: str, out_dir, *, seed: int = 0, quick: bool = Fa
     ``quick``: a short simulation, one tuning round and the report's quick sweep (tests).
     ``progress(step, message)`` is called as the job advances.
     """
-    from footfall._runs import recorded_run, recording_meta
+    from footfall._runs import recorded_run, recording_meta, resolve_gait, say_duty_factor
     from planner._presets import load_preset
     from reports._recording import load_recording
     from reports._report import build_report
     from reports._usd import export_usd
-    from scenarios import DEFAULT_SCENARIO, default_gait_name, load_creature, load_gait, load_scenario
+    from scenarios import DEFAULT_SCENARIO, load_creature, load_scenario
     from tuning._tune import TuneConfig, check_creature, tune
 
     progress = progress or (lambda step, message: None)
     scenario = load_scenario(scenario_name)
-    creature = load_creature(scenario.crowd.creature)
-    check_creature(creature.name)
-    gait = load_gait(default_gait_name(creature.name), creature)
+    creature_ref = check_creature(scenario.crowd.creature)  # a built-in name or the creature file's path
+    creature = load_creature(creature_ref)
+    gait, gait_label, authored = resolve_gait(scenario, creature)
+    say_duty_factor(gait, gait_label, authored, creature, scenario.crowd.speed)
     out = _writable_folder(out_dir)
-    summary: dict = {"scenario": scenario.name, "creature": creature.name, "seed": seed, "quick": quick,
+    summary: dict = {"scenario": scenario.name, "creature": creature.name, "gait": gait.name, "seed": seed,
+                     "quick": quick,
                      "seconds": {}}
     t_job = time.perf_counter()
 
@@ -75,7 +77,7 @@ def run_main_job(scenario_name: str, out_dir, *, seed: int = 0, quick: bool = Fa
 
     t0 = time.perf_counter()
     progress("tune", f"{creature.name}: harvest, fit, exact loss")
-    config = TuneConfig(creature.name, seed=seed, **(QUICK_TUNE if quick else {}))
+    config = TuneConfig(creature_ref, seed=seed, **(QUICK_TUNE if quick else {}))
     preset_path = out / "preset.json"
     tuned = tune(config, preset_path, progress=lambda what, done, total: progress("tune", what), workers=workers)
     summary["tune"] = dict(tuned.summary, wall_s=tuned.wall_s)

@@ -57,14 +57,60 @@ def scenarios_cmd() -> None:
 
 
 @app.command("check")
-def check_cmd(scenario: str = typer.Argument(..., help="Built-in scenario name or path to a scenario .toml")) -> None:
-    """Load and validate a scenario file (exit code 2 with one line naming the problem)."""
-    from scenarios import load_creature, load_scenario
+def check_cmd(
+    file: str = typer.Argument(..., help="A scenario, creature or gait: built-in name or path to a .toml (the kind "
+                               "is told by the file's keys)"),
+    creature: Optional[str] = typer.Option(None, help="Creature name or .toml to check a gait against (needed for a "
+                                           "gait)"),
+    speed: Optional[float] = typer.Option(None, help="Speed in m/s for a gait's duty-factor note (default: the "
+                                          "scenario's, 0.3 for a gait file)"),
+) -> None:
+    """Load and validate a scenario, creature or gait file (exit code 2 with one line naming the problem;
+    warnings, e.g. legs whose rest feet could cross, on stderr with exit code 0)."""
+    from footfall._runs import duty_factor_note, resolve_gait
+    from scenarios import load_creature, load_gait, load_scenario
+    from scenarios._creatures import leg_crossing_warnings
+    from scenarios._files import file_kind
+    from scenarios._gaits import min_stance_feet
 
-    s = load_scenario(scenario)
-    creature = load_creature(s.crowd.creature)
-    _stdout().print(f"{s.source}: ok: {s.name}, {len(s.obstacles)} obstacles, {s.crowd.count} x {creature.name} "
-                    f"({creature.n_legs} legs)")
+    if speed is not None and not (math.isfinite(speed) and speed > 0):
+        raise InputError("argument", "--speed", f"expected a positive number of m/s, got {speed}")
+    kind = file_kind(file)
+    if creature is not None and kind != "gait":
+        raise InputError("argument", "--creature", f"only a gait is checked against a creature; {file} is a {kind}")
+    notes: list[str] = []
+    if kind == "scenario":
+        s = load_scenario(file)
+        c = load_creature(s.crowd.creature)
+        g, label, authored = resolve_gait(s, c)
+        where = s.source
+        line = (f"{s.source}: ok: scenario {s.name}, {len(s.obstacles)} obstacles, {s.crowd.count} x {c.name} "
+                f"({c.n_legs} legs), gait {g.name}")
+        if authored:
+            notes.append(duty_factor_note(g, label, c, speed or s.crowd.speed))
+    elif kind == "creature":
+        c = load_creature(file)
+        g, _, _ = resolve_gait(None, c, "default")
+        where = file
+        line = (f"{file}: ok: creature {c.name}, {c.n_legs} legs x {c.n_segments} segments, reach "
+                f"{c.max_reach:.3g} m; default gait {g.name}: {g.description}")
+    else:
+        if creature is None:
+            raise InputError("argument", "--creature", f"a gait is checked against a creature: footfall check {file} "
+                             "--creature NAME|FILE")
+        c = load_creature(creature)
+        g = load_gait(file, c)
+        least, _ = min_stance_feet(g.swing_start, g.swing_duration)
+        where = file
+        line = (f"{file}: ok: gait {g.name} for {c.name} ({c.n_legs} legs), authored duty factor "
+                f"{g.duty_factor:.2f}, at least {least} feet in stance")
+        notes.append(duty_factor_note(g, file, c, speed or 0.3))
+    _stdout().print(line, markup=False, soft_wrap=True)
+    err = _err()
+    for message in leg_crossing_warnings(c):
+        err.print(f"footfall: warning: {where}: {c.name}: {message}", markup=False, soft_wrap=True)
+    for note in filter(None, notes):
+        err.print(f"footfall: note: {note}", markup=False, soft_wrap=True)
 
 
 @app.command("plan")
@@ -137,13 +183,14 @@ def simulate_cmd(
     """Simulate a crowd walking through a scenario and report what happened."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
-    from footfall._runs import load_named_preset, recorded_run, recording_meta
-    from scenarios import default_gait_name, load_creature, load_gait, load_scenario
+    from footfall._runs import load_named_preset, recorded_run, recording_meta, resolve_gait, say_duty_factor
+    from scenarios import load_creature, load_scenario
 
     s = load_scenario(scenario)
     c = load_creature(creature or s.crowd.creature)
-    g = load_gait(gait or default_gait_name(c.name), c)
+    g, label, authored = resolve_gait(s if creature is None else None, c, gait)
     p = load_named_preset(preset, c.name) if preset is not None else None
+    say_duty_factor(g, label, authored, c, s.crowd.speed, p.timing if p is not None else None)
     if record is not None and not record.endswith(".npz"):
         raise InputError("argument", "--record", f"expected a .npz path, got {record!r}")
     with Progress(TextColumn("simulating"), BarColumn(), TextColumn("{task.completed}/{task.total} frames"),
@@ -223,7 +270,7 @@ def export_usd_cmd(
     out: str = typer.Option(..., "--out", help="Output file: .usda (text), .usdc or .usd (binary)"),
     frames: Optional[int] = typer.Option(None, min=1, help="Frames of 1/30 s (default 90; with --recording: "
                                          "export the first N)"),
-    characters: Optional[int] = typer.Option(None, min=1, help="Crowd size (default 4)"),
+    characters: Optional[int] = typer.Option(None, min=1, help="Crowd size (default: the scenario's)"),
     creature: Optional[str] = typer.Option(None, help="Creature name or .toml (default: the scenario's, or the "
                                            "recording's)"),
     gait: Optional[str] = typer.Option(None, help="Gait name or .toml (default: the creature's)"),
@@ -242,7 +289,7 @@ def export_usd_cmd(
 
     from reports._recording import load_recording
     from reports._usd import check_output_path, export_usd
-    from scenarios import default_gait_name, load_creature, load_gait, load_scenario
+    from scenarios import load_creature, load_scenario
 
     out_path = check_output_path(out)
     if recording is not None:
@@ -257,18 +304,20 @@ def export_usd_cmd(
         if frames is not None:
             run = run.head(frames)
     else:
-        from footfall._runs import load_named_preset, recorded_run, recording_meta
+        from footfall._runs import load_named_preset, recorded_run, recording_meta, resolve_gait, say_duty_factor
 
         frames = frames or 90
         seed = seed or 0
         s = load_scenario(scenario or "mixed")
         c = load_creature(creature or s.crowd.creature)
-        g = load_gait(gait or default_gait_name(c.name), c)
+        g, label, authored = resolve_gait(s if creature is None else None, c, gait)
         p = load_named_preset(preset, c.name) if preset is not None else None
+        say_duty_factor(g, label, authored, c, s.crowd.speed, p.timing if p is not None else None)
         with Progress(TextColumn("simulating"), BarColumn(), TextColumn("{task.completed}/{task.total} frames"),
                       TimeRemainingColumn(), console=_err(), transient=True) as bar:
             task = bar.add_task("frames", total=frames)
-            model, summary, recorder = recorded_run(s, c, g, frames=frames, characters=characters or 4, seed=seed,
+            model, summary, recorder = recorded_run(s, c, g, frames=frames, characters=characters or s.crowd.count,
+                                                    seed=seed,
                                                     preset=p, progress=lambda k: bar.update(task, completed=k))
         # Through the recording file, so a simulated export and the export of its recording are the same.
         with tempfile.TemporaryDirectory(prefix="footfall-usd-") as folder:
@@ -361,8 +410,8 @@ def _field_values(items: Optional[list[str]], option: str) -> tuple[tuple[str, f
 
 @app.command("tune")
 def tune_cmd(
-    creature: str = typer.Option(..., "--creature", help="Built-in creature to tune"),
-    out: Optional[str] = typer.Option(None, "--out", help="Preset file (.json; default out/presets/CREATURE.json); "
+    creature: str = typer.Option(..., "--creature", help="Creature to tune: built-in name or .toml"),
+    out: Optional[str] = typer.Option(None, "--out", help="Preset file (.json; default out/presets/NAME.json); "
                                       "the checkpoint is written beside it"),
     resume: bool = typer.Option(False, "--resume", help="Continue a killed run from its checkpoint"),
     rounds: int = typer.Option(2, "--rounds", help="Outer rounds at most (harvest, fit, exact loss)"),
@@ -381,9 +430,11 @@ def tune_cmd(
     from footfall._distribute import check_workers
     from tuning._tune import TuneConfig, check_creature, check_output, tune
 
+    from scenarios import load_creature
+
     check_workers(workers, cluster)
     check_creature(creature)
-    path = check_output(out or f"out/presets/{creature}.json")
+    path = check_output(out or f"out/presets/{load_creature(creature).name}.json")
     config = TuneConfig(creature, rounds=rounds, seed=seed, start_timing=_field_values(start_timing, "--start-timing"))
     bar = Progress(TextColumn("tune"), BarColumn(), TextColumn("{task.description}"), TimeElapsedColumn(),
                    console=_err(), transient=True)
@@ -396,7 +447,7 @@ def tune_cmd(
     if json_out:
         print(json.dumps(summary))
         return
-    table = Table(title=f"footfall tune {creature}: default -> tuned")
+    table = Table(title=f"footfall tune {load_creature(creature).name}: default -> tuned")
     table.add_column("metric")
     table.add_column("value", justify="right")
     for key, value in summary.items():

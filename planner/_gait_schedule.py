@@ -74,6 +74,14 @@ class GaitSchedule:
         return tuple(g.name for g in self.gaits)
 
     @property
+    def description(self) -> str:
+        """The gaits' descriptions, with the Froude numbers of the changes."""
+        parts = [getattr(self.gaits[0], "description", "") or self.gaits[0].name]
+        for up, gait in zip(self.froude_up, self.gaits[1:]):
+            parts.append(f"above Fr {up:g}: {getattr(gait, 'description', '') or gait.name}")
+        return "; ".join(parts)
+
+    @property
     def name(self) -> str:
         """One name for the schedule: the gait's name, or the names joined by ``+``."""
         return "+".join(self.names)

@@ -20,9 +20,12 @@ from scenarios._files import (
     variant_name,
 )
 from scenarios._gaits import (
+    DEFAULT_GAIT,
     Gait,
     builtin_gait_names,
+    default_gait,
     default_gait_name,
+    generate_gait,
     load_gait,
     min_stance_feet,
     required_stance_feet,
@@ -42,6 +45,7 @@ DEFAULT_SCENARIO = "mixed"
 """The scenario used when none is named."""
 
 __all__ = [
+    "DEFAULT_GAIT",
     "DEFAULT_SCENARIO",
     "Camera",
     "CrateRecipe",
@@ -54,7 +58,9 @@ __all__ = [
     "builtin_creature_names",
     "builtin_gait_names",
     "builtin_scenario_names",
+    "default_gait",
     "default_gait_name",
+    "generate_gait",
     "flat_heightfield",
     "hills_heightfield",
     "load_creature",

@@ -164,3 +164,67 @@ class Creature:
         body = 0.5 * float(np.hypot(*self.body_box))
         feet = float(np.linalg.norm(self.rest_feet, axis=1).max()) + 0.5 * max(self.foot_length, self.foot_width)
         return max(body, feet)
+
+
+def _segment_distance(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndarray) -> float:
+    """Least distance (m) between the 2-D segments p0-p1 and q0-q1."""
+    def cross(a, b):
+        return a[0] * b[1] - a[1] * b[0]
+
+    d1, d2, r = p1 - p0, q1 - q0, q0 - p0
+    denominator = cross(d1, d2)
+    if abs(denominator) > 1e-15:
+        t, u = cross(r, d2) / denominator, cross(r, d1) / denominator
+        if 0.0 <= t <= 1.0 and 0.0 <= u <= 1.0:
+            return 0.0
+
+    def point_segment(p, a, b):
+        ab = b - a
+        length2 = float(ab @ ab)
+        t = 0.0 if length2 == 0.0 else min(max(float((p - a) @ ab) / length2, 0.0), 1.0)
+        return float(np.linalg.norm(p - (a + t * ab)))
+
+    return min(point_segment(p0, q0, q1), point_segment(p1, q0, q1), point_segment(q0, p0, p1),
+               point_segment(q1, p0, p1))
+
+
+def leg_crossing_warnings(creature: Creature) -> tuple[str, ...]:
+    """Pairs of legs whose rest poses are close enough to cross or collide, as messages.
+
+    Seen from above (body frame (forward, lateral)), two legs are flagged when
+
+    * their rest feet are closer than ``foot_length`` (centre to centre), or
+    * their hip -> rest-foot segments pass within ``foot_width`` of each other (the segments
+      start at the hips' projections; legs whose hips are already that close are only
+      compared on the outer half of each segment).
+
+    A warning, not an error: such a creature loads and walks, but its feet may collide or
+    its legs cross (the run's counters say how often).
+
+    Returns
+    -------
+    tuple of str
+        One line per pair, e.g. ``legs L1 and L2: rest feet 0.031 m apart, closer than a
+        foot length (0.05 m)``; empty when nothing is close.
+    """
+    hips = np.asarray(creature.hips, dtype=np.float64)[:, [0, 2]]
+    feet = np.asarray(creature.rest_feet, dtype=np.float64)
+    names = creature.leg_names
+    out = []
+    for i in range(creature.n_legs):
+        for j in range(i + 1, creature.n_legs):
+            pair = f"legs {names[i]} and {names[j]}"
+            gap = float(np.linalg.norm(feet[i] - feet[j]))
+            if gap < creature.foot_length:
+                out.append(f"{pair}: rest feet {gap:.3g} m apart, closer than a foot length "
+                           f"({creature.foot_length:g} m)")
+                continue
+            hi, hj = hips[i], hips[j]
+            if float(np.linalg.norm(hi - hj)) < creature.foot_width:
+                hi, hj = 0.5 * (hi + feet[i]), 0.5 * (hj + feet[j])
+            gap = _segment_distance(hi, feet[i], hj, feet[j])
+            if gap < creature.foot_width:
+                what = "cross" if gap == 0.0 else f"pass {gap:.3g} m apart"
+                out.append(f"{pair}: hip-to-rest-foot lines {what}, within a foot width "
+                           f"({creature.foot_width:g} m)")
+    return tuple(out)

@@ -105,12 +105,66 @@ def _split_field(field: str) -> tuple[str, list[int]]:
     return match.group(1), [int(i) for i in re.findall(r"\d+", match.group(2))]
 
 
+# --------------------------------------------------------------------------- kinds of file
+
+_KIND_KEYS = {
+    "scenario": ("terrain", "crowd", "obstacles", "obstacles_random", "camera", "seed"),
+    "creature": ("legs", "leg_defaults", "standing_height", "body_thickness", "body_box", "foot"),
+    "gait": ("swing",),
+}
+
+
+def file_kind(name_or_path: str | Path) -> str:
+    """``"scenario"``, ``"creature"`` or ``"gait"``: what a built-in name or a ``.toml`` file is.
+
+    A built-in name is looked up among the scenarios, then the creatures, then the gaits;
+    a variant ``NAME@key=value`` is a scenario. A file is told by its keys (``[swing]``: a
+    gait; ``legs``, ``foot``, ``standing_height``, ...: a creature; ``[terrain]``,
+    ``[crowd]``, ...: a scenario). Raises :class:`InputError` for a file with none of them.
+    """
+    from scenarios._gaits import builtin_gait_names
+
+    text = str(name_or_path)
+    if isinstance(name_or_path, str) and not _is_file(Path(text)):
+        if text in builtin_scenario_names() or ("@" in text and text.partition("@")[0] in builtin_scenario_names()):
+            return "scenario"
+        if text in builtin_creature_names():
+            return "creature"
+        if text in builtin_gait_names():
+            return "gait"
+    if "@" in text and not _is_file(Path(text)):
+        return "scenario"
+    path, file = _resolve(name_or_path, DATA_DIR, builtin_scenario_names(), "file")
+    data = _read_toml(path, file, "file")
+    scores = {kind: sum(key in data for key in keys) for kind, keys in _KIND_KEYS.items()}
+    kind = max(scores, key=lambda k: scores[k])
+    if scores[kind] == 0:
+        raise InputError(file, "(document)", "neither a scenario ([terrain], [crowd]), a creature (legs, foot, "
+                         "standing_height) nor a gait ([swing]) file")
+    return kind
+
+
 # --------------------------------------------------------------------------- creatures
+
+
+_FILE_CREATURES: dict[str, Creature] = {}
+"""Creatures this process loaded from files, by name (the last one loaded under each name)."""
+
+
+def file_creature(name: str) -> Creature | None:
+    """The creature named ``name`` that this process last loaded from a file, or None.
+
+    Lets code that only has a creature's name (e.g. :func:`scenarios.default_gait_name`)
+    tell a user creature from a built-in one.
+    """
+    return _FILE_CREATURES.get(name)
 
 
 def load_creature(name_or_path: str | Path) -> Creature:
     """A built-in creature by name (see :func:`builtin_creature_names`) or a creature ``.toml`` file.
 
+    This is the one resolver of a creature reference: every command that takes a creature
+    (``--creature``, ``[crowd] creature``) goes through it, so a file works wherever a name does.
     Raises :class:`InputError` naming the file and field on any problem.
     """
     path, file = _resolve(name_or_path, CREATURES_DIR, builtin_creature_names(), "creature")
@@ -162,7 +216,7 @@ def _load_creature_file(path: Path, file: str) -> Creature:
         return {"foot_length": "foot.length", "foot_width": "foot.width"}.get(name, field)
 
     try:
-        return Creature(
+        creature = Creature(
             name=model.name or path.stem,
             leg_names=tuple(leg.name for leg in model.legs),
             hips=[leg.hip for leg in model.legs],
@@ -179,6 +233,9 @@ def _load_creature_file(path: Path, file: str) -> Creature:
         if error.file != UNATTRIBUTED:
             raise
         raise InputError(file, file_field(error.field), error.reason) from None
+    if not file.startswith("builtin:"):
+        _FILE_CREATURES[creature.name] = creature
+    return creature
 
 
 # --------------------------------------------------------------------------- scenarios
@@ -253,6 +310,7 @@ def load_scenario(name_or_path: str | Path) -> Scenario:
         goal=model.crowd.goal,
         waypoints=model.crowd.waypoints,
         feet_spacing=model.crowd.feet_spacing,
+        gait=None if model.crowd.gait is None else _crowd_gait(model.crowd.gait, creature, base, file),
     ))
     creature_radius = creature.rest_radius * crowd.feet_spacing
     _check_crowd_on_terrain(crowd, creature_radius, terrain, file)
@@ -335,6 +393,36 @@ def _crowd_creature(reference: str, base: Path, file: str) -> tuple[str, Creatur
             raise InputError(file, "crowd.creature", f"creature file not found: {path}")
         raise InputError(file, "crowd.creature", f"unknown creature {reference!r}; built-ins are: {', '.join(names)}")
     return str(path), _load_creature_file(path, str(path))
+
+
+def _crowd_gait(reference: str, creature: Creature, base: Path, file: str) -> str:
+    """``crowd.gait`` resolved (a name, or a file path next to the scenario) and loaded once for ``creature``.
+
+    A gait file's own problems name the gait file and its field; a name or path that leads
+    nowhere, or a built-in gait that does not fit the creature, names ``FILE: crowd.gait``.
+    """
+    from scenarios._gaits import DEFAULT_GAIT, builtin_gait_names, load_gait
+
+    names = builtin_gait_names()
+    if reference == DEFAULT_GAIT or reference in names:
+        resolved = reference
+    else:
+        path = Path(reference)
+        if not path.is_absolute():
+            path = base / path
+        if not _is_file(path):
+            if path.suffix == ".toml" or "/" in reference or "\\" in reference:
+                raise InputError(file, "crowd.gait", f"gait file not found: {path}")
+            raise InputError(file, "crowd.gait", f"unknown gait {reference!r}; built-ins are: "
+                             f"{', '.join(names)}, or {DEFAULT_GAIT!r} (the creature's default)")
+        resolved = str(path)
+    try:
+        load_gait(resolved, creature)
+    except InputError as error:
+        if error.file.startswith("builtin:") or error.file == creature.name:
+            raise InputError(file, "crowd.gait", f"{error.file}: {error.field}: {error.reason}") from None
+        raise
+    return resolved
 
 
 def _check_crowd_on_terrain(crowd: CrowdSpawn, creature_radius: float, terrain: Heightfield, file: str) -> None:

@@ -33,11 +33,18 @@ Built-in gaits (see each file for its biology): ``spider-alternating-tetrapod``,
 ``spider-metachronal-wave``, ``ant-tripod``, ``ant-tetrapod``,
 ``quadruped-walk``, ``quadruped-trot``, ``quadruped-pace``, ``robot5-wave``.
 :func:`default_gait_name` gives each built-in creature's default gait.
+
+**Any creature with 3 legs or more has a default gait** (:func:`default_gait`): the
+built-in one for a built-in creature, otherwise one generated from its morphology
+(:func:`generate_gait`). The gait name ``"default"`` (``--gait default``,
+``[crowd] gait = "default"``) means that gait.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+from itertools import permutations
 from pathlib import Path
 from typing import Annotated
 
@@ -48,7 +55,7 @@ from footfall._errors import InputError
 from scenarios import _schema as schema
 from scenarios._arrays import UNATTRIBUTED, frozen_array, invalid, readonly
 from scenarios._creatures import Creature
-from scenarios._files import _read_toml, _resolve, _split_field, load_creature
+from scenarios._files import _read_toml, _resolve, _split_field, file_creature, load_creature
 
 GAITS_DIR = Path(__file__).parent / "data" / "gaits"
 """Built-in gaits (``*.toml``)."""
@@ -63,6 +70,19 @@ DEFAULT_GAITS: dict[str, str] = {
     "robot5": "robot5-wave",
 }
 """Default gait of each built-in creature."""
+
+DEFAULT_GAIT = "default"
+"""Gait name meaning "the creature's default gait" (:func:`default_gait`)."""
+
+GENERATED_DUTY_FACTOR = 0.72
+"""Authored duty factor of a generated gait: the timing model's duty factor at rest
+(``planner._timing.GaitTiming.duty_at_rest``); the run rescales it with speed like any gait's."""
+
+CENTRELINE_FRACTION = 0.25
+"""A hip whose |lateral| is below this fraction of the largest |lateral| is on the centreline."""
+
+_RING_SEARCH_MAX = 7
+"""Rings of at most this many legs try every order of phases; larger ones use the best rotation."""
 
 
 # --------------------------------------------------------------------------- support rule
@@ -227,18 +247,216 @@ def builtin_gait_names(creature: Creature | str | None = None) -> tuple[str, ...
 
 
 def default_gait_name(creature_name: Creature | str) -> str:
-    """The default built-in gait of a built-in creature (``spider`` -> ``spider-metachronal-wave``, ...).
+    """The name of a creature's default gait, for :func:`load_gait`.
 
-    Accepts a :class:`Creature` too (its name is used). Raises
-    :class:`InputError` for a creature without a default.
+    A built-in creature (``spider`` -> ``spider-metachronal-wave``, ...) gets its built-in
+    default. A :class:`Creature`, or the name of a creature this process loaded from a file,
+    whose legs the built-in default does not fit gets :data:`DEFAULT_GAIT` (``"default"``):
+    :func:`load_gait` then generates its gait (:func:`generate_gait`). Raises
+    :class:`InputError` for the name of a creature that is neither.
     """
-    name = creature_name.name if isinstance(creature_name, Creature) else str(creature_name)
-    if name not in DEFAULT_GAITS:
-        raise InputError(name, "gait", f"no default gait for creature {name!r}; defaults exist for "
-                         f"{', '.join(sorted(DEFAULT_GAITS))}; name a gait file")
-    return DEFAULT_GAITS[name]
+    if isinstance(creature_name, Creature):
+        creature = creature_name
+    else:
+        creature = file_creature(str(creature_name))
+        if creature is None:
+            name = str(creature_name)
+            if name not in DEFAULT_GAITS:
+                raise InputError(name, "gait", f"no default gait for creature {name!r}; defaults exist for "
+                                 f"{', '.join(sorted(DEFAULT_GAITS))} and for creatures loaded from a file; "
+                                 "name a gait file")
+            return DEFAULT_GAITS[name]
+    name = DEFAULT_GAITS.get(creature.name)
+    if name is not None and _fits(name, creature):
+        return name
+    return DEFAULT_GAIT
 
 
+def _fits(gait_name: str, creature: Creature) -> bool:
+    try:
+        load_gait(gait_name, creature)
+    except InputError:
+        return False
+    return True
+
+
+def default_gait(creature: Creature) -> Gait:
+    """The gait ``creature`` walks with when none is named.
+
+    The built-in default (:data:`DEFAULT_GAITS`) for a built-in creature whose legs it
+    names; otherwise the gait generated from the morphology (:func:`generate_gait`).
+    Deterministic: the same creature always gets the same gait.
+
+    Parameters
+    ----------
+    creature : Creature
+
+    Returns
+    -------
+    Gait
+        In the creature's leg order; it keeps the support rule (:func:`check_support`).
+    """
+    name = DEFAULT_GAITS.get(creature.name)
+    if name is not None:
+        try:
+            return load_gait(name, creature)
+        except InputError:  # a user creature borrowing a built-in name, with other legs
+            pass
+    return generate_gait(creature)
+
+
+# --------------------------------------------------------------------------- generated gaits
+
+
+def _evenly_around(points: np.ndarray) -> bool:
+    """True for hips on a circle about their centre at evenly spread angles (a round body, whatever
+    its orientation): radii within 10 % of their mean and every angular gap within 10 % of 2 pi / L."""
+    n = points.shape[0]
+    if n < 3:
+        return False
+    rel = points - points.mean(axis=0)
+    radius = np.hypot(rel[:, 0], rel[:, 1])
+    if radius.mean() <= 0.0 or np.any(np.abs(radius - radius.mean()) > 0.1 * radius.mean()):
+        return False
+    angles = np.sort(np.mod(np.arctan2(rel[:, 1], rel[:, 0]), 2.0 * np.pi))
+    gaps = np.diff(np.append(angles, angles[0] + 2.0 * np.pi))
+    return bool(np.all(np.abs(gaps - 2.0 * np.pi / n) <= 0.1 * 2.0 * np.pi / n))
+
+
+def leg_sides(creature: Creature) -> tuple[tuple[int, ...], tuple[int, ...]] | None:
+    """(left legs, right legs), each ordered back to front, or None for a round body.
+
+    Hips evenly spread around a circle are a round body, whatever the body's orientation.
+    Otherwise a creature is bilateral when no hip is on the centreline (|lateral| below
+    :data:`CENTRELINE_FRACTION` of the largest |lateral|), each side has at least 2 legs
+    and the two sides differ by at most one leg. A side is ordered by the hips' forward
+    coordinate (ties by the rest feet's, then by leg index).
+    """
+    hips = np.asarray(creature.hips, dtype=np.float64)
+    if _evenly_around(hips[:, [0, 2]]):
+        return None
+    lateral = hips[:, 2]
+    widest = float(np.max(np.abs(lateral)))
+    if widest <= 0.0 or np.any(np.abs(lateral) < CENTRELINE_FRACTION * widest):
+        return None
+    left = [i for i in range(creature.n_legs) if lateral[i] > 0.0]
+    right = [i for i in range(creature.n_legs) if lateral[i] < 0.0]
+    if min(len(left), len(right)) < 2 or abs(len(left) - len(right)) > 1:
+        return None
+
+    def back_to_front(legs: list[int]) -> tuple[int, ...]:
+        return tuple(sorted(legs, key=lambda i: (hips[i, 0], creature.rest_feet[i, 0], i)))
+
+    return back_to_front(left), back_to_front(right)
+
+
+def wave_latency(n_side: int) -> float:
+    """Phase (fraction of a cycle) between a leg's swing start and that of the leg behind it on its side.
+
+    ``1/4`` for 2 legs a side (the lateral-sequence walk), ``1/n`` for 3 or 4 (one wave runs
+    down the side per cycle), ``ceil(n/4)/n`` for more (several waves a side, as in millipedes,
+    so that neighbours stay at least about a quarter of a cycle apart).
+    """
+    if n_side <= 2:
+        return 0.25
+    return math.ceil(n_side / 4) / n_side
+
+
+def ring_order(creature: Creature) -> tuple[int, ...]:
+    """Legs in order around the body, counter-clockwise seen from above (forward, then left, ...).
+
+    The angle of a leg is that of its hip in the body's (forward, lateral) plane, or of its
+    rest foot when the hip is at the centre; the leg nearest straight ahead comes first.
+    """
+    hips = np.asarray(creature.hips, dtype=np.float64)[:, [0, 2]]
+    rest = np.asarray(creature.rest_feet, dtype=np.float64)
+    where = np.where(np.linalg.norm(hips, axis=1, keepdims=True) > 1e-9, hips, rest)
+    angle = np.mod(np.arctan2(where[:, 1], where[:, 0]), 2.0 * np.pi)
+    angle = np.where(angle > 2.0 * np.pi - 1e-9, 0.0, angle)
+    return tuple(int(i) for i in np.lexsort((np.arange(creature.n_legs), angle)))
+
+
+def _ring_slots(n: int) -> tuple[int, ...]:
+    """Slots (phase = slot / n) for the legs of a ring of ``n``: ring neighbours as far apart in phase as can be.
+
+    Maximises the least circular slot distance between ring neighbours (the ring closes):
+    every order for small rings (the first leg fixed at slot 0, ties: the lexicographically
+    first), else the best rotation ``slot_i = i k mod n`` with ``k`` coprime to ``n``.
+    """
+
+    def least_gap(slots) -> int:
+        gaps = [(slots[(i + 1) % n] - slots[i]) % n for i in range(n)]
+        return min(min(g, n - g) for g in gaps)
+
+    if n <= _RING_SEARCH_MAX:
+        best = max(((0,) + rest for rest in permutations(range(1, n))), key=least_gap)
+        return tuple(best)
+    ks = [k for k in range(1, n // 2 + 1) if math.gcd(k, n) == 1]
+    k = max(ks)
+    return tuple((i * k) % n for i in range(n))
+
+
+def generate_gait(creature: Creature) -> Gait:
+    """A gait for any creature with at least 3 legs, from its morphology alone.
+
+    * **Bilateral body** (:func:`leg_sides`): on each side a metachronal wave runs back to
+      front (each leg lifts :func:`wave_latency` of a cycle after the leg behind it, as in
+      Wilson 1967's insects and spiders); the right side's back leg lifts half a cycle after
+      the left's, so opposite legs alternate.
+    * **Round body** (no clear sides: a hip on the centreline, or sides too unequal, e.g. a
+      five-legged radial robot): the swings are spread evenly over the cycle, one every
+      ``1/L``, in an order around the body (:func:`ring_order`, :func:`_ring_slots`) that
+      keeps ring neighbours as far apart in phase as possible.
+
+    Every leg swings once a cycle for the same duration: ``1 - GENERATED_DUTY_FACTOR``,
+    shortened (never below a twentieth of a cycle) until ring or side neighbours are never
+    in the air together and the support rule holds (:func:`check_support`).
+
+    Raises
+    ------
+    InputError
+        On field ``gait`` for a creature with fewer than 3 legs.
+    """
+    n = creature.n_legs
+    if n < 3:
+        raise InputError(creature.name, "gait", f"cannot generate a gait for {n} legs (needs 3 or more); "
+                         "name a gait file")
+    start = np.zeros(n)
+    sides = leg_sides(creature)
+    neighbour_gap = 1.0
+    if sides is not None:
+        for side, offset in zip(sides, (0.0, 0.5)):
+            latency = wave_latency(len(side))
+            for k, leg in enumerate(side):
+                start[leg] = (offset + k * latency) % 1.0
+            neighbour_gap = min(neighbour_gap, latency)
+        kind = (f"metachronal wave back to front on each side ({len(sides[0])} left, {len(sides[1])} right), "
+                "sides half a cycle apart")
+    else:
+        ring = ring_order(creature)
+        slots = _ring_slots(n)
+        for leg, slot in zip(ring, slots):
+            start[leg] = slot / n
+        gaps = [(slots[(i + 1) % n] - slots[i]) % n for i in range(n)]
+        neighbour_gap = min(min(g, n - g) for g in gaps) / n
+        kind = "swings spread evenly over the cycle, neighbours around the body far apart in phase"
+    start = np.round(start, 12) % 1.0
+    duration = min(1.0 - GENERATED_DUTY_FACTOR, neighbour_gap)
+    while True:
+        try:
+            check_support(creature.leg_names, start, np.full(n, duration))
+            break
+        except InputError:
+            if duration <= 0.05:
+                raise
+            duration = max(0.05, 0.9 * duration)
+    return Gait(
+        name=f"{creature.name}-generated",
+        leg_names=creature.leg_names,
+        swing_start=start,
+        swing_duration=np.full(n, duration),
+        description=f"Generated from the morphology: {kind}; DF {1.0 - duration:.2f}.",
+    )
 def _as_creature(creature: Creature | str | Path) -> Creature:
     return creature if isinstance(creature, Creature) else load_creature(creature)
 
@@ -255,6 +473,8 @@ def load_gait(name_or_path: str | Path, creature: Creature | str | Path) -> Gait
     an impossible gait (support rule, module doc).
     """
     creature = _as_creature(creature)
+    if isinstance(name_or_path, str) and name_or_path == DEFAULT_GAIT:
+        return default_gait(creature)
     path, file = _resolve(name_or_path, GAITS_DIR, builtin_gait_names(), "gait")
     model: _GaitFile = schema.validate(_GaitFile, _read_toml(path, file, "gait"), file)
     given = list(model.swing)

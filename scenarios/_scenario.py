@@ -45,6 +45,11 @@ class CrowdSpawn:
         (k, 2) world (x, z) points visited in order before ``goal`` (k may be 0).
     feet_spacing:
         Scale (> 0) applied to the creature's rest feet (forward, lateral).
+    gait:
+        The gait the crowd walks with: a built-in gait name, ``"default"``, or a path to a
+        gait ``.toml`` (loaders store it already resolved against the scenario file); pass to
+        :func:`scenarios.load_gait` with the creature. None: the creature's gaits
+        (its default, or its built-in schedule by speed).
     """
 
     creature: str
@@ -57,10 +62,13 @@ class CrowdSpawn:
     goal: np.ndarray
     waypoints: np.ndarray | None = None
     feet_spacing: float = 1.0
+    gait: str | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.creature, str) or not self.creature.strip():
             raise invalid("creature", "must be a non-empty string")
+        if self.gait is not None and (not isinstance(self.gait, str) or not self.gait.strip()):
+            raise invalid("gait", "must be a non-empty string or None")
         if isinstance(self.count, bool) or not isinstance(self.count, (int, np.integer)) or self.count < 1:
             raise invalid("count", "must be an integer >= 1")
         object.__setattr__(self, "count", int(self.count))

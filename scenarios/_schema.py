@@ -140,6 +140,7 @@ class CrowdFile(_Model):
     goal: Vec2
     waypoints: list[Vec2] = []
     feet_spacing: Positive = 1.0
+    gait: Text | None = None
 
 
 class CameraFile(_Model):
