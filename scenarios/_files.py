@@ -385,14 +385,21 @@ def _crowd_creature(reference: str, base: Path, file: str) -> tuple[str, Creatur
     names = builtin_creature_names()
     if reference in names:
         return reference, load_creature(reference)
+    path = _file_next_to(reference, base, file, "crowd.creature", "creature", f"built-ins are: {', '.join(names)}")
+    return str(path), _load_creature_file(path, str(path))
+
+
+def _file_next_to(reference: str, base: Path, file: str, field: str, kind: str, known: str) -> Path:
+    """The file ``reference`` names (relative paths from the scenario file's folder ``base``), or
+    one line on ``FILE: FIELD``: a path that leads nowhere, or a name that is not one of ``known``."""
     path = Path(reference)
     if not path.is_absolute():
         path = base / path
     if not _is_file(path):
         if path.suffix == ".toml" or "/" in reference or "\\" in reference:
-            raise InputError(file, "crowd.creature", f"creature file not found: {path}")
-        raise InputError(file, "crowd.creature", f"unknown creature {reference!r}; built-ins are: {', '.join(names)}")
-    return str(path), _load_creature_file(path, str(path))
+            raise InputError(file, field, f"{kind} file not found: {path}")
+        raise InputError(file, field, f"unknown {kind} {reference!r}; {known}")
+    return path
 
 
 def _crowd_gait(reference: str, creature: Creature, base: Path, file: str) -> str:
@@ -407,15 +414,8 @@ def _crowd_gait(reference: str, creature: Creature, base: Path, file: str) -> st
     if reference == DEFAULT_GAIT or reference in names:
         resolved = reference
     else:
-        path = Path(reference)
-        if not path.is_absolute():
-            path = base / path
-        if not _is_file(path):
-            if path.suffix == ".toml" or "/" in reference or "\\" in reference:
-                raise InputError(file, "crowd.gait", f"gait file not found: {path}")
-            raise InputError(file, "crowd.gait", f"unknown gait {reference!r}; built-ins are: "
-                             f"{', '.join(names)}, or {DEFAULT_GAIT!r} (the creature's default)")
-        resolved = str(path)
+        resolved = str(_file_next_to(reference, base, file, "crowd.gait", "gait", f"built-ins are: {', '.join(names)}, "
+                                     f"or {DEFAULT_GAIT!r} (the creature's default)"))
     try:
         load_gait(resolved, creature)
     except InputError as error:
