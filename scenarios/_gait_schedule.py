@@ -1,7 +1,7 @@
 """Each creature's gaits by speed: the built-in schedules and the generated default.
 
 See :mod:`planner._gait_schedule` for what a schedule does at run time. The built-in
-creatures change gait as the biomechanics notes say (``/work/shared/biomechanics.md``):
+creatures change gait as the biomechanics notes say (``shared/biomechanics.md``):
 
 * quadruped: lateral-sequence walk, trot above Fr = 0.35 (walk below about 0.3, trot above
   about 0.5: Alexander & Jayes 1983);
