@@ -15,6 +15,9 @@ feet for characters whose IK is off, which is how they are drawn):
   pelvis, along the heading) overlap, summed over frames;
 * ``shared_foot_spots``: pairs of stance feet of different characters closer than a foot
   length, summed over frames;
+* ``unavoidable_contacts``: rendered feet inside a box that moves at least as fast as the
+  creature's top speed (``CrowdModel.top_speed``): no escape exists, so such a contact is
+  counted apart from ``collisions``;
 * ``stuck_seconds``: character-seconds in which a character that has not reached its goal
   moved less than 10 % of its asked speed over the last 2 s (:data:`STUCK_WINDOW_S`).
 
@@ -65,6 +68,7 @@ class FrameCounters:
     def __init__(self, model, state):
         self.model = model
         self.collisions = 0
+        self.unavoidable_contacts = 0
         self.leg_crossings = 0
         self.max_stance_slip_m = 0.0
         self.residuals: list[np.ndarray] = []
@@ -89,11 +93,20 @@ class FrameCounters:
         obs = model.raster.obstacles
         if len(obs.yaws):
             centres, yaws = obs.poses_at(state.t)
-            count_collisions(feet, 0.5 * model.creature.foot_length, 0.5 * model.creature.foot_width, state.foot_yaws,
-                             np.ascontiguousarray(centres), np.ascontiguousarray(obs.sizes, dtype=np.float64),
-                             np.ascontiguousarray(yaws), np.ascontiguousarray(obs.forbidden, dtype=np.bool_),
-                             self._per_char)
-            self.collisions += int(self._per_char.sum())
+            # A box at least as fast as the creature's top speed cannot be escaped: its contacts
+            # are unavoidable_contacts, the others collisions.
+            previous, _ = obs.poses_at(state.t - model.dt)
+            box_speed = np.hypot(*(centres - previous)[:, [0, 2]].T) / model.dt
+            unstoppable = box_speed >= model.top_speed
+            for mask, name in ((~unstoppable, "collisions"), (unstoppable, "unavoidable_contacts")):
+                if not mask.any():
+                    continue
+                count_collisions(feet, 0.5 * model.creature.foot_length, 0.5 * model.creature.foot_width,
+                                 state.foot_yaws, np.ascontiguousarray(centres[mask]),
+                                 np.ascontiguousarray(obs.sizes[mask], dtype=np.float64),
+                                 np.ascontiguousarray(yaws[mask]),
+                                 np.ascontiguousarray(np.asarray(obs.forbidden)[mask], dtype=np.bool_), self._per_char)
+                setattr(self, name, getattr(self, name) + int(self._per_char.sum()))
         count_polyline_crossings(np.ascontiguousarray(rendered_joints(model, state)), self._per_char)
         self.leg_crossings += int(self._per_char.sum())
         # Stance slip against the touch-down point: feet that stayed down keep their anchor, feet

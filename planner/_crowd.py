@@ -49,6 +49,8 @@ from planner._weights import ScoringWeights
 
 DT = 1.0 / 30.0
 TRANSITION_RATE = 0.5
+ESCAPE_FROUDE = 0.5
+"""The Froude number of a creature's top speed (issue 13: every creature walks up to Fr 0.5)."""
 """Cycles of phase per second a disk moves during a gait change with speed (a new gait within a stride)."""
 STAGES = ("steer", "gait", "swing", "requests", "maps", "plan", "pelvis", "ik")
 
@@ -135,6 +137,9 @@ class CrowdModel:
     speed_cap: float = math.inf  # m/s, the fastest speed the legs carry at the stride law (planner._workspace)
     speed_asked: float = 0.0  # m/s, the scenario's speed before the cap
     step_height: float = 0.0  # m, the swings' preferred lift (paper §3.1 'step height')
+    # m/s, the fastest a character walks to get out of the way (of a box, of another): its speed
+    # cap, at most Froude number ESCAPE_FROUDE. A box at least this fast cannot be escaped.
+    top_speed: float = math.inf
 
     @property
     def n_legs(self) -> int:
@@ -805,7 +810,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
     if abs(raster.frame.cell_size - config.cell_size) > 1e-12:
         raise ValueError(f"raster: cell size {raster.frame.cell_size} differs from the planner's {config.cell_size}")
     from planner._gait_schedule import as_schedule
-    from planner._timing import hip_height
+    from planner._timing import GRAVITY, hip_height
     from planner._workspace import speed_cap, stance_windows
 
     schedule = as_schedule(gait)
@@ -814,12 +819,13 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
     # the controller caps the speed there (reported as speed_cap; the CLI says so).
     cap = speed_cap(timing, hip_height(creature), float(np.min(window[:, 1] - window[:, 0])))
     speed = min(speed_asked, cap)
+    escape = min(cap, math.sqrt(ESCAPE_FROUDE * GRAVITY * hip_height(creature)))
     model = CrowdModel(
         creature=creature, gait=schedule.gaits[0], timing=timing, weights=weights, config=config, controller=controller, lod=lod,
         lod_mode=lod_mode, raster=raster, camera=scenario.camera, dt=DT, feet_spacing=spacing,
         hips_body=hips_body, rest_body=rest_body, reach=np.asarray(creature.leg_reach, dtype=np.float64),
         leg_static=leg_static, fixed_budget=budget, schedule=schedule, stance_window=window, speed_cap=cap,
-        speed_asked=speed_asked, step_height=step_height)
+        speed_asked=speed_asked, step_height=step_height, top_speed=max(escape, speed))
     rng = np.random.default_rng(seed)
     positions = spawn_positions(scenario, creature, n)
     if scenario.crowd.heading_mode == "random":

@@ -65,6 +65,7 @@ class SimulationSummary:
     body_overlaps: int = 0
     shared_foot_spots: int = 0
     stuck_seconds: float = 0.0
+    unavoidable_contacts: int = 0
 
     def to_json(self) -> dict:
         return asdict(self)
@@ -248,5 +249,5 @@ def simulate(model: CrowdModel, state: CrowdState, frames: int, recorder: Record
         speed_asked=float(model.speed_asked), speed_cap=None if math.isinf(model.speed_cap) else float(model.speed_cap),
         speed_reached=reached, duty_factor_mean=stance_feet / walking_feet if walking_feet else None,
         body_overlaps=counters.body_overlaps, shared_foot_spots=counters.shared_foot_spots,
-        stuck_seconds=counters.stuck_seconds,
+        stuck_seconds=counters.stuck_seconds, unavoidable_contacts=counters.unavoidable_contacts,
         gait_fractions={name: float(n / max(gait_frames.sum(), 1)) for name, n in zip(model.schedule.names, gait_frames)})

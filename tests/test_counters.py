@@ -126,3 +126,22 @@ def test_a_character_that_does_not_move_for_three_seconds_is_stuck_for_one():
         state.pelvis[:, 0] += 0.5 * state.desired_speed * model.dt
         moving.update(state)
     assert moving.stuck_seconds == 0.0
+
+
+def test_a_foot_under_a_box_faster_than_the_creature_is_an_unavoidable_contact():
+    import dataclasses
+
+    model, state = _standing("crates-moving")
+    # The first crate of `crates-moving` slides at 0.15 m/s from (0, -3): slower than the
+    # spider's top speed, so a foot inside it is a collision the character could have avoided.
+    assert 0.15 < model.top_speed
+    centres, _ = model.raster.obstacles.poses_at(state.t)
+    state.feet[0, 2] = (centres[0, 0], 0.0, centres[0, 2])
+    state.ik_on[0] = False
+    counters = FrameCounters(model, state)
+    counters.update(state)
+    assert (counters.collisions, counters.unavoidable_contacts) == (1, 0)
+    # The same crate against a creature whose top speed is below 0.15 m/s: no escape existed.
+    slow = FrameCounters(dataclasses.replace(model, top_speed=0.1), state)
+    slow.update(state)
+    assert (slow.collisions, slow.unavoidable_contacts) == (0, 1)
