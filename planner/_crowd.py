@@ -200,6 +200,7 @@ class CrowdState:
     speed_limit: np.ndarray  # (C,) m/s, the sustainable speed learnt from holds (inf: never held)
     last_move: np.ndarray  # (C, 2) m, the pelvis's move on the ground in the last steer stage
     cannot_follow: np.ndarray  # (C, L) bool: the last look-ahead found the leg cannot follow its stance foot
+    pose_before: np.ndarray  # (C, 6) pelvis x, y, z, heading, pitch, roll at the start of the frame
     gait_index: np.ndarray  # (C,) int: the schedule's gait each character walks with (or moves toward)
     stride_frequency: np.ndarray  # (C,) Hz, the needle's rate at the last gait stage
     counters: dict = field(default_factory=dict)
@@ -263,6 +264,9 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
         direction /= np.maximum(np.hypot(direction[:, 0], direction[:, 1]), 1e-9)[:, None]
     desired = np.arctan2(direction[:, 1], direction[:, 0])
     turn = _wrap(desired - state.heading)
+    # A held body keeps its whole pose (a turn swings the hips away from the stance feet just as a
+    # move does), and a character at its goal stops turning toward it.
+    turn[state.body_held | arrived] = 0.0
     state.heading = _wrap(state.heading + np.clip(turn, -ctl.turn_rate * dt, ctl.turn_rate * dt))
     v_des = np.where(arrived, 0.0, state.desired_speed * np.maximum(0.3, np.cos(np.clip(turn, -np.pi / 2, np.pi / 2))))
     # The speed limit learnt from holds grows back (ControllerConfig: sustainable speed).
@@ -282,7 +286,8 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
     state.pelvis[:, [0, 2]] += state.last_move
     # Feet feedback (§3.2): a significant mean offset between preferred and chosen footprints moves the pelvis.
     fb = state.feedback
-    significant = (np.hypot(fb[:, 0], fb[:, 1]) > ctl.feedback_threshold * model.rest_radius) & ~state.body_held
+    significant = ((np.hypot(fb[:, 0], fb[:, 1]) > ctl.feedback_threshold * model.rest_radius) & ~state.body_held
+                   & ~arrived)
     if significant.any():
         move = fb[significant] * min(1.0, ctl.feedback_gain * dt)
         idx = np.flatnonzero(significant)
@@ -698,6 +703,34 @@ def stage_ik(model: CrowdModel, state: CrowdState, on_screen: np.ndarray) -> Non
         state.residual[cs, ls] = res.residual
         state.fk_feet[cs, ls] = res.feet
     state.ik_on[on_screen] = True
+    _take_back_unfollowed_poses(model, state, on_screen)
+
+
+def _take_back_unfollowed_poses(model: CrowdModel, state: CrowdState, on_screen: np.ndarray) -> None:
+    """A stance foot stays where it touched down: a body whose new pose (a move, a turn, a
+    pelvis that rose with the hull) leaves a stance leg unable to reach its foot takes the
+    whole frame's pose back, and holds until that foot has stepped (the look-ahead of
+    ``stage_requests`` misses what it does not predict, such as the hull after a lift-off)."""
+    ctl = model.controller
+    failed = state.in_stance & (state.residual > ctl.ik_slip_margin) & on_screen[:, None]
+    bad = failed.any(axis=1)
+    if not bad.any():
+        return
+    before = state.pose_before[bad]
+    state.pelvis[bad] = before[:, :3]
+    state.heading[bad] = before[:, 3]
+    state.pitch[bad] = before[:, 4]
+    state.roll[bad] = before[:, 5]
+    state.speed[bad] = 0.0
+    state.body_held[bad] = True
+    state.cannot_follow[bad] |= failed[bad]
+    hips = hips_world(model, state)
+    cs, ls = np.nonzero(bad[:, None] & np.ones_like(state.in_stance))
+    res = _solve_feet(model, state, cs, ls, hips[cs, ls], ctl.ik_iterations, ctl.ik_restarts)
+    state.angles[cs, ls] = res.angles
+    state.residual[cs, ls] = res.residual
+    state.fk_feet[cs, ls] = res.feet
+    state.counters["pose_takebacks"] += int(bad.sum())
 
 
 # ----------------------------------------------------------------------------- set-up
@@ -860,10 +893,10 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         plan_heading=np.repeat(headings[:, None], L, axis=1), plan_speed=np.zeros((n, L)),
         feet_spacing=np.ones(n), plan_spacing=np.ones((n, L)), foot_yaws=yaws,
         gaits=init_gaits([schedule.gaits[int(k)] for k in gait_index], n, rng.uniform(0.0, 1.0, n), transition_rate=TRANSITION_RATE), angles=angles, residual=np.zeros((n, L)),
-        ik_on=np.zeros(n, np.bool_), fk_feet=feet.copy(), hull=np.zeros(n), pelvis_rise=np.zeros(n), body_held=np.zeros(n, np.bool_), speed_limit=np.full(n, np.inf), last_move=np.zeros((n, 2)), cannot_follow=np.zeros((n, L), np.bool_),
+        ik_on=np.zeros(n, np.bool_), fk_feet=feet.copy(), hull=np.zeros(n), pelvis_rise=np.zeros(n), body_held=np.zeros(n, np.bool_), speed_limit=np.full(n, np.inf), last_move=np.zeros((n, 2)), cannot_follow=np.zeros((n, L), np.bool_), pose_before=np.zeros((n, 6)),
         gait_index=gait_index, stride_frequency=np.zeros(n),
         counters={k: 0 for k in ("steps", "plans", "holds", "replans", "forbidden_footprints", "cells_expanded",
-                                 "couples_evaluated")})
+                                 "couples_evaluated", "pose_takebacks")})
     stage_pelvis(model, state)
     state.pelvis_rise[:] = 0.0
     stage_ik(model, state, np.ones(n, np.bool_))
@@ -910,6 +943,7 @@ def step(model: CrowdModel, state: CrowdState) -> dict[str, float]:
     boxes = _boxes_now(model, state.t)
 
     t0 = clock()
+    state.pose_before = np.column_stack([state.pelvis, state.heading, state.pitch, state.roll])
     stage_steer(model, state, boxes)
     t1 = clock()
     frequency, enter, _ = stage_gait(model, state)

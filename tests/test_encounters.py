@@ -1,0 +1,164 @@
+"""Scripted encounters: tiny deterministic scenarios whose right answer can be checked by hand
+(issue 20, item 1).
+
+Each builds a 12 x 12 m flat world with one crate and one spider, runs it frame by frame and
+checks the promise on every frame with plain geometry written here (a point inside an oriented
+rectangle), beside the simulator's own counters.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+from planner._counters import FrameCounters
+from planner._crowd import DT, init_crowd, stage_steer, step
+from scenarios import load_creature, load_scenario
+from scenarios._gait_schedule import gait_schedule
+
+WORLD = """
+name = "{name}"
+seed = 0
+[terrain]
+kind = "flat"
+size = [12.0, 12.0]
+cell_size = 0.05
+{crate}
+[crowd]
+creature = "spider"
+centre = {start}
+heading = 0.0
+speed = {speed}
+goal = {goal}
+"""
+CRATE = """[[obstacles]]
+centre = {centre}
+size = [{width}, 0.3, {width}]
+kind = "forbidden"
+{motion}
+"""
+
+
+def _world(tmp_path, name, *, crate_centre, crate_width, start, goal, speed=0.3, velocity=None):
+    motion = "" if velocity is None else f"motion = {{ kind = \"velocity\", velocity = {list(velocity)} }}"
+    crate = CRATE.format(centre=list(crate_centre), width=crate_width, motion=motion)
+    path = tmp_path / f"{name}.toml"
+    path.write_text(WORLD.format(name=name, crate=crate, start=list(start), goal=list(goal), speed=speed))
+    scenario, creature = load_scenario(str(path)), load_creature("spider")
+    return init_crowd(scenario, creature, gait_schedule(creature), n_characters=1, seed=0)
+
+
+def _inside(points_xz, centre_xz, half, yaw):
+    """Points (n, 2) strictly inside the rectangle (centre, half extents along its yawed axes)."""
+    d = np.asarray(points_xz, dtype=float) - np.asarray(centre_xz, dtype=float)
+    c, s = math.cos(yaw), math.sin(yaw)
+    along = d[:, 0] * c + d[:, 1] * s
+    across = -d[:, 0] * s + d[:, 1] * c
+    return (np.abs(along) < half[0]) & (np.abs(across) < half[1])
+
+
+def _crate_now(model, t):
+    centres, yaws = model.raster.obstacles.poses_at(t)
+    size = model.raster.obstacles.sizes[0]
+    return centres[0, [0, 2]], 0.5 * size[[0, 2]], float(yaws[0])
+
+
+def _run(model, state, frames, each_frame):
+    counters = FrameCounters(model, state)
+    for _ in range(frames):
+        step(model, state)
+        counters.update(state)
+        each_frame(state)
+    return counters
+
+
+def test_a_crate_driven_across_a_stance_foot_makes_it_step_away_before_contact(tmp_path):
+    # A spider stands at its goal (0, 0), facing +x; its left feet rest about 0.3 m to its
+    # left. A 0.16 m crate slides along z = 0.32 at 0.2 m/s from x = -1.5: it sweeps through
+    # the left feet's spots (and never reaches the body, 0.075 m wide).
+    model, state = _world(tmp_path, "across-stance", crate_centre=(-1.5, 0.32), crate_width=0.16, start=(0.0, 0.0),
+                          goal=(0.0, 0.0), velocity=(0.2, 0.0))
+    left = state.feet[0, :, 2] > 0.2
+    centre, half, yaw = _crate_now(model, 7.5)
+    assert _inside(state.feet[0][left][:, [0, 2]], centre, half, yaw).any(), "the crate must sweep a foot's spot"
+    inside = []
+
+    def check(s):
+        c, h, y = _crate_now(model, s.t)
+        feet = np.where(s.ik_on[0], s.fk_feet[0], s.feet[0])
+        inside.append(int(_inside(feet[:, [0, 2]], c, h, y).sum()))
+
+    counters = _run(model, state, 450, check)
+    assert sum(inside) == 0
+    assert counters.collisions == 0
+    assert state.counters["steps"] > 0
+    assert counters.max_stance_slip_m <= 1e-3
+
+
+def test_a_crate_crossing_a_planned_swing_replans_it_the_same_frame(tmp_path):
+    # The spider walks +x from (-2, 0) at 0.3 m/s; a 0.3 m crate crosses its path at x = 1,
+    # moving +z at 0.3 m/s from z = -2: it reaches the path as the spider gets there.
+    model, state = _world(tmp_path, "across-swing", crate_centre=(1.0, -2.0), crate_width=0.3, start=(-2.0, 0.0),
+                          goal=(4.0, 0.0), velocity=(0.0, 0.3))
+    blocked = []
+
+    def check(s):
+        # After every frame, no swinging foot's remaining path runs through the crate where it is now.
+        c, h, y = _crate_now(model, s.t)
+        for leg in np.flatnonzero(~s.in_stance[0]):
+            k = s.trajectories.shape[2]
+            u = s.swing_t[0, leg] / s.swing_T[0, leg]
+            rest = s.trajectories[0, leg, int(u * (k - 1)):, :]
+            low = rest[:, 1] < 0.3 + 1e-9  # under the crate's top
+            blocked.append(int(_inside(rest[low][:, [0, 2]], c, h, y).any()))
+
+    counters = _run(model, state, 600, check)
+    assert state.counters["replans"] > 0
+    assert sum(blocked) == 0
+    assert counters.collisions == 0
+    assert state.pelvis[0, 0] > 2.0, "the spider walks on past the crate's path"
+
+
+def test_a_spider_steered_straight_at_a_forbidden_crate_passes_around_it(tmp_path):
+    # The straight line from (-3, 0) to the goal (3, 0) runs through a 0.5 m crate at the origin.
+    model, state = _world(tmp_path, "straight-at", crate_centre=(0.0, 0.0), crate_width=0.5, start=(-3.0, 0.0),
+                          goal=(3.0, 0.0))
+    body = np.asarray(model.creature.body_box, dtype=float)
+    gaps = []
+
+    def check(s):
+        c, h, _ = _crate_now(model, s.t)
+        # Distance from the pelvis to the crate's square, less the body's half-width: the clearance.
+        d = np.maximum(np.abs(s.pelvis[0, [0, 2]] - c) - h, 0.0)
+        gaps.append(float(np.hypot(*d)) - 0.5 * body[1])
+
+    counters = _run(model, state, 900, check)
+    assert min(gaps) >= 0.0
+    assert counters.collisions == 0
+    assert counters.max_stance_slip_m <= 1e-3
+    assert state.pelvis[0, 0] > 0.5, "the spider got past the crate"
+
+
+def test_feet_feedback_shifts_the_pelvis_by_the_gain_of_a_significant_offset(tmp_path):
+    # Paper §5, Fig. 7: when the chosen footprints sit on average off the preferred ones by
+    # more than the threshold, the pelvis moves toward them at feedback_gain per second.
+    model, state = _world(tmp_path, "feedback", crate_centre=(5.0, 5.0), crate_width=0.2, start=(0.0, 0.0),
+                          goal=(4.0, 0.0))
+    ctl = model.controller
+    boxes = (np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), np.zeros(0, np.bool_), np.zeros(0, np.bool_))
+    offset = np.array([0.0, 0.08])  # 8 cm to the left, above the threshold (0.15 x rest radius ~ 5 cm)
+    assert np.hypot(*offset) > ctl.feedback_threshold * model.rest_radius
+    state.feedback[0] = offset
+    before = state.pelvis[0].copy()
+    stage_steer(model, state, boxes)
+    moved = state.pelvis[0] - before
+    gain = min(1.0, ctl.feedback_gain * DT)
+    # The walk moves the pelvis along the heading (x) only; the feedback adds gain x offset in z.
+    assert moved[2] == pytest.approx(gain * offset[1], abs=1e-12)
+    assert state.feedback[0] == pytest.approx((1.0 - gain) * offset, abs=1e-12)
+    # Below the threshold, nothing moves sideways (but for the walk's own 1e-15 m of turning
+    # back toward the goal).
+    state.feedback[0] = 0.5 * ctl.feedback_threshold * model.rest_radius * np.array([0.0, 1.0])
+    before = state.pelvis[0].copy()
+    stage_steer(model, state, boxes)
+    assert state.pelvis[0, 2] == pytest.approx(before[2], abs=1e-9)
