@@ -260,19 +260,39 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
         weight = np.clip(1.0 - gap / ctl.avoid_margin, 0.0, 1.0) ** 2
         ahead = (-(rel[..., 0] * direction[:, None, 0] + rel[..., 1] * direction[:, None, 1]) / rn) > -0.2
         push = ((weight * ahead)[..., None] * rel / rn[..., None]).sum(axis=1)
+        # Keep right around boxes too: a box dead ahead pushes straight back, and the push and ORCA
+        # would hold the character in front of it (a symmetric standstill).
+        veer = (weight * ahead).max(axis=1) * math.tan(KEEP_RIGHT)
+        push += veer[:, None] * np.column_stack([direction[:, 1], -direction[:, 0]])
         direction = direction + 1.5 * push
         direction /= np.maximum(np.hypot(direction[:, 0], direction[:, 1]), 1e-9)[:, None]
+    # Reciprocal avoidance (ORCA) of the other characters and of forbidden or moving boxes: the
+    # velocity closest to the preferred one that stays clear for the horizon.
+    goal_speed = np.where(arrived, 0.0, np.minimum(state.desired_speed, state.speed_limit))
+    preferred = direction * goal_speed[:, None]
+    velocity, avoided = _avoid(model, state, preferred, dist)
+    fast = np.hypot(velocity[:, 0], velocity[:, 1]) > 1e-6
+    direction = np.where((avoided & fast)[:, None], velocity / np.maximum(np.hypot(*velocity.T), 1e-12)[:, None],
+                         direction)
     desired = np.arctan2(direction[:, 1], direction[:, 0])
     turn = _wrap(desired - state.heading)
     # A held body keeps its whole pose (a turn swings the hips away from the stance feet just as a
     # move does), and a character at its goal stops turning toward it.
-    turn[state.body_held | arrived] = 0.0
-    state.heading = _wrap(state.heading + np.clip(turn, -ctl.turn_rate * dt, ctl.turn_rate * dt))
-    v_des = np.where(arrived, 0.0, state.desired_speed * np.maximum(0.3, np.cos(np.clip(turn, -np.pi / 2, np.pi / 2))))
+    turn[state.body_held | (arrived & ~avoided)] = 0.0
+    # The feet are planned for walking along the heading: a body turning on the spot swings its
+    # hips across the stance feet (legs cross): below a quarter of its goal speed, a character
+    # turns more slowly, down to a quarter of the turn rate when standing.
+    rate = ctl.turn_rate * dt * np.clip(4.0 * state.speed / np.maximum(goal_speed, 1e-9), 0.25, 1.0)
+    state.heading = _wrap(state.heading + np.clip(turn, -rate, rate))
+    forward = np.cos(np.clip(turn, -np.pi / 2, np.pi / 2))
+    # Unhindered, a character keeps walking (at least 30 %) while it turns; avoiding, it walks only
+    # as far along its heading as the avoiding velocity goes (sideways into a neighbour is no way out).
+    v_des = np.where(avoided, np.hypot(velocity[:, 0], velocity[:, 1]) * forward,
+                     np.where(arrived, 0.0, state.desired_speed * np.maximum(0.3, forward)))
     # The speed limit learnt from holds grows back (ControllerConfig: sustainable speed).
     free = ~state.body_held
     state.speed_limit[free] += ctl.limit_recovery * state.desired_speed[free] * dt
-    v_des = np.minimum(v_des, state.speed_limit)
+    v_des = np.minimum(v_des, np.where(avoided, np.maximum(state.speed_limit, v_des), state.speed_limit))
     state.speed = state.speed + np.clip(v_des - state.speed, -ctl.acceleration * dt, ctl.acceleration * dt)
     # Legs that reach: no faster than keeps every stance foot inside its leg's stance window until
     # the needle lifts it (planner._workspace). The cap falls gradually as a foot nears the rear
@@ -294,6 +314,59 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
         state.pelvis[idx, 0] += move[:, 0]
         state.pelvis[idx, 2] += move[:, 1]
         fb[idx] -= move
+
+
+AVOID_RADIUS = 0.6
+"""x rest radius: the disc a character keeps clear of others (less than half the spawn spacing, so a crowd
+spawned as promised starts clear) and of forbidden and moving boxes."""
+AVOID_HORIZON = 2.0
+"""s: ORCA's time horizon between characters."""
+AVOID_BOX_HORIZON = 1.5
+"""s: ORCA's time horizon against boxes."""
+AVOID_NEIGHBOURS = 10
+"""Nearest characters each one avoids (ORCA's usual cap: the rest are further than these)."""
+KEEP_RIGHT = 0.1
+"""rad: a character with a neighbour near aims this much right of its way; ORCA alone can settle
+in a symmetric standstill (two characters exactly head-on), a shared convention breaks the tie."""
+
+
+def _avoid(model: CrowdModel, state: CrowdState, preferred: np.ndarray, to_target: np.ndarray):
+    """(velocity (C, 2), avoided (C,) bool): ORCA's velocity for every character, and whether it
+    differs from the preferred one (a neighbour or a box is in the way)."""
+    from planner._kernels_avoidance import neighbour_lists, orca_velocities
+
+    n = state.pelvis.shape[0]
+    xz = np.ascontiguousarray(state.pelvis[:, [0, 2]])
+    radius = AVOID_RADIUS * model.rest_radius
+    top = model.top_speed if math.isfinite(model.top_speed) else float(np.max(state.desired_speed))
+    start, index = neighbour_lists(xz, 2.0 * radius + 2.0 * top * AVOID_HORIZON, AVOID_NEIGHBOURS)
+    near = np.zeros(n, np.bool_)
+    if index.size:
+        rows = np.repeat(np.arange(n), np.diff(start))
+        gap = np.hypot(*(xz[index] - xz[rows]).T)
+        near[rows[gap < 4.0 * radius]] = True
+    if near.any():
+        c, s = math.cos(KEEP_RIGHT), math.sin(-KEEP_RIGHT)
+        turn = near & (to_target > 1.0)
+        p = preferred[turn]
+        preferred = preferred.copy()
+        preferred[turn] = np.column_stack([c * p[:, 0] - s * p[:, 1], s * p[:, 0] + c * p[:, 1]])
+    obs = model.raster.obstacles
+    if len(obs.yaws):
+        now, yaws = obs.poses_at(state.t)
+        later, _ = obs.poses_at(state.t + model.dt)
+        active = np.asarray(obs.forbidden) | ~np.asarray(obs.is_static)
+        boxes = (np.ascontiguousarray(now[:, [0, 2]]), np.ascontiguousarray(0.5 * np.asarray(obs.sizes)[:, [0, 2]]),
+                 np.ascontiguousarray(yaws, dtype=np.float64),
+                 np.ascontiguousarray((later - now)[:, [0, 2]] / model.dt), np.ascontiguousarray(active))
+    else:
+        boxes = (np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), np.zeros((0, 2)), np.zeros(0, np.bool_))
+    velocity = np.stack([np.cos(state.heading), np.sin(state.heading)], axis=1) * state.speed[:, None]
+    out = np.empty((n, 2))
+    orca_velocities(xz, np.ascontiguousarray(velocity), np.ascontiguousarray(preferred), np.full(n, radius),
+                    np.full(n, top), start, index, *boxes, AVOID_HORIZON, AVOID_BOX_HORIZON, model.dt, out)
+    avoided = np.hypot(*(out - preferred).T) > 1e-9
+    return out, avoided
 
 
 def stance_room(model: CrowdModel, state: CrowdState) -> np.ndarray:
@@ -706,6 +779,11 @@ def stage_ik(model: CrowdModel, state: CrowdState, on_screen: np.ndarray) -> Non
     _take_back_unfollowed_poses(model, state, on_screen)
 
 
+def _pose(state: CrowdState) -> np.ndarray:
+    """(C, 6) pelvis x, y, z, heading, pitch, roll."""
+    return np.column_stack([state.pelvis, state.heading, state.pitch, state.roll])
+
+
 def _take_back_unfollowed_poses(model: CrowdModel, state: CrowdState, on_screen: np.ndarray) -> None:
     """A stance foot stays where it touched down: a body whose new pose (a move, a turn, a
     pelvis that rose with the hull) leaves a stance leg unable to reach its foot takes the
@@ -725,11 +803,15 @@ def _take_back_unfollowed_poses(model: CrowdModel, state: CrowdState, on_screen:
     state.body_held[bad] = True
     state.cannot_follow[bad] |= failed[bad]
     hips = hips_world(model, state)
-    cs, ls = np.nonzero(bad[:, None] & np.ones_like(state.in_stance))
-    res = _solve_feet(model, state, cs, ls, hips[cs, ls], ctl.ik_iterations, ctl.ik_restarts)
-    state.angles[cs, ls] = res.angles
-    state.residual[cs, ls] = res.residual
-    state.fk_feet[cs, ls] = res.feet
+    for stance, iterations, restarts in ((True, ctl.ik_iterations, ctl.ik_restarts),
+                                         (False, ctl.ik_swing_iterations, 0)):
+        cs, ls = np.nonzero(bad[:, None] & (state.in_stance == stance))
+        if cs.size == 0:
+            continue
+        res = _solve_feet(model, state, cs, ls, hips[cs, ls], iterations, restarts)
+        state.angles[cs, ls] = res.angles
+        state.residual[cs, ls] = res.residual
+        state.fk_feet[cs, ls] = res.feet
     state.counters["pose_takebacks"] += int(bad.sum())
 
 
@@ -899,6 +981,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
                                  "couples_evaluated", "pose_takebacks")})
     stage_pelvis(model, state)
     state.pelvis_rise[:] = 0.0
+    state.pose_before = _pose(state)  # nothing to take back before the first frame
     stage_ik(model, state, np.ones(n, np.bool_))
     return model, state
 
@@ -943,7 +1026,7 @@ def step(model: CrowdModel, state: CrowdState) -> dict[str, float]:
     boxes = _boxes_now(model, state.t)
 
     t0 = clock()
-    state.pose_before = np.column_stack([state.pelvis, state.heading, state.pitch, state.roll])
+    state.pose_before = _pose(state)
     stage_steer(model, state, boxes)
     t1 = clock()
     frequency, enter, _ = stage_gait(model, state)

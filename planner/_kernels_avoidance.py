@@ -275,9 +275,11 @@ def orca_velocities(positions, velocities, preferred, radii, max_speed, neighbou
         out[c, 1] = result[1]
 
 
-def neighbour_lists(positions: np.ndarray, radius: float) -> tuple[np.ndarray, np.ndarray]:
-    """The other characters within ``radius`` (m) of each one, in CSR form (start (C + 1,),
-    index), each list sorted (deterministic). Uses a k-d tree: O(C log C), not O(C^2).
+def neighbour_lists(positions: np.ndarray, radius: float, max_neighbours: int | None = None
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """The other characters within ``radius`` (m) of each one (at most the ``max_neighbours``
+    nearest), in CSR form (start (C + 1,), index), each list sorted (deterministic). Uses a
+    k-d tree: O(C log C), not O(C^2).
 
     >>> start, index = neighbour_lists(np.array([[0.0, 0.0], [1.0, 0.0], [5.0, 0.0]]), 2.0)
     >>> start.tolist(), index.tolist()
@@ -289,7 +291,19 @@ def neighbour_lists(positions: np.ndarray, radius: float) -> tuple[np.ndarray, n
     n = positions.shape[0]
     if n == 0:
         return np.zeros(1, np.int64), np.zeros(0, np.int64)
-    pairs = cKDTree(positions).query_pairs(radius, output_type="ndarray")
+    tree = cKDTree(positions)
+    if max_neighbours is not None and max_neighbours < n - 1:
+        # The nearest ones: k + 1 hits include the character itself (ties broken by index).
+        dist, idx = tree.query(positions, k=max_neighbours + 1, distance_upper_bound=radius)
+        rows = np.repeat(np.arange(n), max_neighbours + 1).reshape(n, -1)
+        keep = np.isfinite(dist) & (idx != rows)
+        found = np.where(keep, idx, n)
+        found.sort(axis=1)
+        counts = keep.sum(axis=1)
+        start = np.zeros(n + 1, np.int64)
+        np.cumsum(counts, out=start[1:])
+        return start, np.ascontiguousarray(found[found < n], dtype=np.int64)
+    pairs = tree.query_pairs(radius, output_type="ndarray")
     both = np.concatenate([pairs, pairs[:, ::-1]]) if pairs.size else np.zeros((0, 2), np.int64)
     order = np.lexsort((both[:, 1], both[:, 0]))
     both = both[order]

@@ -158,3 +158,10 @@ def test_neighbour_lists_are_sorted_symmetric_and_exclude_self():
     start, index = neighbour_lists(pos, 0.6)
     lists = [index[start[i]:start[i + 1]].tolist() for i in range(4)]
     assert lists == [[1, 2], [0], [0], []]
+
+
+def test_neighbour_lists_keep_the_nearest_when_capped():
+    pos = np.array([[0.0, 0.0], [0.3, 0.0], [0.0, 0.2], [0.5, 0.0], [9.0, 9.0]])
+    start, index = neighbour_lists(pos, 1.0, max_neighbours=2)
+    lists = [index[start[i]:start[i + 1]].tolist() for i in range(5)]
+    assert lists == [[1, 2], [0, 3], [0, 1], [0, 1], []]
