@@ -219,6 +219,86 @@ def simulate_cmd(
         out.print(f"recording: {record}")
 
 
+@app.command("evaluate")
+def evaluate_cmd(
+    scenarios: Optional[list[str]] = typer.Argument(None, help="Scenarios (default: every built-in)"),
+    creatures: Optional[str] = typer.Option(None, "--creatures", help="Comma-separated creature names or .toml files "
+                                            "(default: every built-in)"),
+    seeds: int = typer.Option(3, "--seeds", help="Seeds per scenario x creature"),
+    seed_base: Optional[int] = typer.Option(None, "--seed-base", help="Seeds S, S+1, ... (default: fresh random "
+                                            "seeds, printed)"),
+    characters: int = typer.Option(6, "--characters", help="Crowd size of every run"),
+    frames: int = typer.Option(300, "--frames", help="Frames of 1/30 s per run"),
+    lod: str = typer.Option("off", "--lod", help="Level of detail: on, zoomed or off"),
+    workers: Optional[int] = typer.Option(None, "--workers", help="Local worker processes (default: one per core; "
+                                          "1: in-process)"),
+    cluster: Optional[str] = typer.Option(None, "--cluster", help="Dask scheduler address (tcp://host:8786)"),
+    out: Optional[str] = typer.Option(None, "--out", help="Folder for index.html, evaluate.json, runs.csv and "
+                                      "pictures of the worst runs"),
+    strict: bool = typer.Option(False, "--strict", help="Exit 1 when any promise is violated"),
+    json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),
+) -> None:
+    """Check every promise (collisions, crossings, overlaps, slip, IK, stuck, strides, speed) on scenario x
+    creature x seed runs; a table of violations and the exact command that replays each of the worst runs."""
+    from pathlib import Path
+
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+    from footfall._distribute import check_workers
+    from reports._evaluate import draw_seeds, evaluate, picture_png, run_one, table_rows, write_outputs
+    from scenarios import builtin_creature_names, builtin_scenario_names, load_creature, load_scenario
+
+    for option, value in (("--seeds", seeds), ("--characters", characters), ("--frames", frames)):
+        if value < 1:
+            raise InputError("argument", option, f"expected an integer >= 1, got {value}")
+    if lod not in ("on", "zoomed", "off"):
+        raise InputError("argument", "--lod", f"expected one of on, zoomed, off, got {lod!r}")
+    check_workers(workers, cluster)
+    names = list(scenarios or builtin_scenario_names())
+    kinds = [c.strip() for c in creatures.split(",")] if creatures else list(builtin_creature_names())
+    if any(not c for c in kinds):
+        raise InputError("argument", "--creatures", f"expected comma-separated names, got {creatures!r}")
+    for name in names:
+        load_scenario(name)  # bad input fails here, in one line, before any run
+    for name in kinds:
+        load_creature(name)
+    drawn = draw_seeds(seeds, seed_base)
+    err = _err()
+    err.print(f"seeds: {', '.join(map(str, drawn))}", markup=False)
+    total = len(names) * len(kinds) * len(drawn)
+    with Progress(TextColumn("evaluate"), BarColumn(), TextColumn("{task.completed}/{task.total} runs"),
+                  TimeElapsedColumn(), console=err, transient=True) as bar:
+        task = bar.add_task("runs", total=total)
+        result = evaluate(names, kinds, drawn, characters=characters, frames=frames, lod=lod, workers=workers,
+                          cluster=cluster, progress=lambda _t, done: bar.update(task, completed=done))
+    if out is not None:
+        pictures = {}
+        for k, run in enumerate(result["failed_runs"][:3]):
+            pictures[f"worst-{k}.png"] = picture_png(run_one({**run, "characters": characters, "frames": frames,
+                                                              "lod": lod, "picture": True}))
+        write_outputs(Path(out), result, pictures)
+    public = {k: v for k, v in result.items() if not k.startswith("_")}
+    if json_out:
+        print(json.dumps(public))
+    else:
+        columns, rows = table_rows(result)
+        table = Table(title=f"Violations: {result['runs']} runs, {result['character_frames']} character-frames, "
+                            f"{result['wall_s']:.0f} s")
+        for col in columns:
+            table.add_column(col, justify="left" if col in ("scenario", "creature") else "right")
+        for row in rows:
+            table.add_row(*row)
+        console = _stdout()
+        console.print(table)
+        for run in result["failed_runs"][:5]:
+            console.print(f"{sum(run['violations'].values())} violations: {run['replay']}", markup=False,
+                          soft_wrap=True)
+        if out is not None:
+            console.print(f"report: {Path(out) / 'index.html'}")
+    if strict and result["failed_runs"]:
+        raise typer.Exit(1)
+
+
 @app.command("run")
 def run_cmd(
     scenario: str = typer.Argument("mixed", help="Built-in scenario name or path to a scenario .toml"),
