@@ -8,7 +8,6 @@ import re
 import shutil
 import subprocess
 import sys
-import time
 
 import numpy as np
 import pytest
@@ -23,14 +22,13 @@ def run(*args, timeout=600):
 
 @pytest.fixture(scope="module")
 def quick(tmp_path_factory):
-    """One quick report for the module: (folder, --json summary, seconds)."""
+    """One quick report for the module: (folder, --json summary). Its wall time is a benchmark, not a test:
+    ``python -m benchmarks.report_bench``."""
     root = tmp_path_factory.mktemp("quick")
     out = root / "report"
-    t0 = time.perf_counter()
     proc = run("report", "--quick", "--out", str(out), "--json")
-    seconds = time.perf_counter() - t0
     assert proc.returncode == 0, proc.stderr
-    return out, json.loads(proc.stdout), seconds
+    return out, json.loads(proc.stdout)
 
 
 def _image_stats(path):
@@ -45,9 +43,8 @@ def _image_stats(path):
 # ----------------------------------------------------------------------------- the quick report
 
 
-def test_quick_report_writes_a_complete_folder_in_time(quick):
-    out, summary, seconds = quick
-    assert seconds < 60, f"the quick report took {seconds:.1f} s"
+def test_quick_report_writes_a_complete_folder(quick):
+    out, summary = quick
     for name in ("index.html", "results.csv", "summary.csv", "paired.csv", "results.json", "pareto.png",
                  "stride.png"):
         assert (out / name).is_file(), name
@@ -59,7 +56,7 @@ def test_quick_report_writes_a_complete_folder_in_time(quick):
 
 
 def test_csv_and_json_agree(quick):
-    out, summary, _ = quick
+    out, summary = quick
     data = json.loads((out / "results.json").read_text())
     runs = [t for t in data["tasks"] if t["kind"] != "paired"]
     with open(out / "results.csv", newline="") as fh:
@@ -93,7 +90,7 @@ def test_csv_and_json_agree(quick):
 def test_pareto_front_and_recommended_budget(quick):
     from reports._pareto import COST, LOSS, dominates
 
-    _, summary, _ = quick
+    _, summary = quick
     budgets = [r for r in summary["rows"] if r["kind"] == "budget"]
     assert len(budgets) >= 3
     front = [r for r in budgets if r["on_front"]]
@@ -109,7 +106,7 @@ def test_pareto_front_and_recommended_budget(quick):
 
 
 def test_exhaustive_search_is_never_beaten(quick):
-    out, _, _ = quick
+    out, _ = quick
     data = json.loads((out / "results.json").read_text())
     for task in data["tasks"]:
         if task["kind"] == "paired":
@@ -126,12 +123,12 @@ def test_exhaustive_search_is_never_beaten(quick):
 
 
 def test_fig13_situation_is_the_crowds_plan(quick):
-    _, summary, _ = quick
+    _, summary = quick
     assert summary["scenes"] and all(s["heatmap_matches_crowd"] for s in summary["scenes"])
 
 
 def test_report_pictures_are_not_blank(quick):
-    out, summary, _ = quick
+    out, summary = quick
     pictures = [out / "pareto.png", out / "stride.png"] + sorted(out.glob("gait_disks_*.png")) \
         + sorted(out.glob("footprints_*.png")) + [out / r for s in summary["scenes"] for r in s["renders"]]
     assert len([p for p in pictures if "renders" in str(p)]) == 2 * len(summary["scenes"])
@@ -185,7 +182,7 @@ window.addEventListener('load', function () {
 
 @pytest.mark.skipif(shutil.which("chromium") is None, reason="Debian chromium is not installed")
 def test_every_image_loads_in_headless_chromium(quick, tmp_path):
-    out, _, _ = quick
+    out, _ = quick
     # A copy elsewhere: the folder must stand on its own (relative links only).
     copy = tmp_path / "copied-report"
     shutil.copytree(out, copy)
