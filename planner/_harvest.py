@@ -50,7 +50,7 @@ class FootHarvest:
     cand_terms: np.ndarray  # (n, 5) footprint goodnesses (the runtime's)
     cand_scores: np.ndarray  # (n,) footprint scores (the runtime's)
     levels: np.ndarray  # (S,) slice levels, m above terrain (inf: no slices)
-    d_ref: float  # m, reference of the length goodness
+    d_ref: np.ndarray  # (n,) m, each candidate's reference of the length goodness (source -> footprint)
     couple_valid: np.ndarray  # (n, S) bool: a path exists
     couple_raw: np.ndarray  # (n, S, 5) RAW_METRICS
     couple_terms: np.ndarray  # (n, S, 10) goodnesses (the runtime's)
@@ -62,7 +62,7 @@ def _harvest_kernel_call(elevation, ground, forbidden, origin_x, origin_z, offse
     out = harvest_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, source, preferred, hip,
                               reach_xz, step_height, legs, block_radius, w, cfg, slice_size)
     rc, xyz, feats, terms, scores, levels, d_ref, valid, raw, cterms, cscores = out
-    return FootHarvest(rc, xyz, feats, terms, scores, levels, float(d_ref), valid, raw, cterms, cscores)
+    return FootHarvest(rc, xyz, feats, terms, scores, levels, d_ref, valid, raw, cterms, cscores)
 
 
 def harvest_foot(maps: LocalMaps, query: FootQuery, weights: ScoringWeights | None = None,
@@ -105,7 +105,7 @@ class Harvest:
     source: np.ndarray  # (F, 3)
     preferred: np.ndarray  # (F, 2)
     cell_size: np.ndarray  # (F,) m
-    d_ref: np.ndarray  # (F,) m
+    d_ref: np.ndarray  # (F, K) m, each candidate's reference of the length goodness (padding: 1)
     cand_mask: np.ndarray  # (F, K) bool
     cand_xyz: np.ndarray  # (F, K, 3)
     cand_centre_xz: np.ndarray  # (F, K, 2) centres of the candidate cells (a footprint is its cell's point nearest P)
@@ -187,6 +187,7 @@ def _pack(rows: list[dict], creatures, scenarios, weights: np.ndarray, timing: n
     cand_features = np.zeros((f, k, N_FEATURES))
     cand_terms = np.zeros((f, k, N_FOOTPRINT_TERMS))
     cand_scores = np.zeros((f, k))
+    d_ref = np.ones((f, k))
     couple_mask = np.zeros((f, k, s), np.bool_)
     couple_raw = np.zeros((f, k, s, N_RAW))
     couple_terms = np.zeros((f, k, s, N_TERMS))
@@ -200,6 +201,7 @@ def _pack(rows: list[dict], creatures, scenarios, weights: np.ndarray, timing: n
         cand_features[i, :n] = h.cand_features
         cand_terms[i, :n] = h.cand_terms
         cand_scores[i, :n] = h.cand_scores
+        d_ref[i, :n] = h.d_ref
         couple_mask[i, :n, :m] = h.couple_valid
         couple_raw[i, :n, :m] = h.couple_raw
         couple_terms[i, :n, :m] = h.couple_terms
@@ -215,7 +217,7 @@ def _pack(rows: list[dict], creatures, scenarios, weights: np.ndarray, timing: n
         leg_height=col("leg_height"), speed=col("speed"), forward=col("forward").reshape(f, 2),
         relative_swing=col("relative_swing"), source=col("source").reshape(f, 3),
         preferred=col("preferred").reshape(f, 2), cell_size=col("cell_size"),
-        d_ref=np.array([r["foot"].d_ref for r in rows]), cand_mask=cand_mask, cand_xyz=cand_xyz,
+        d_ref=d_ref, cand_mask=cand_mask, cand_xyz=cand_xyz,
         cand_centre_xz=cand_centre_xz,
         cand_features=cand_features, cand_terms=cand_terms, cand_scores=cand_scores, couple_mask=couple_mask,
         couple_raw=couple_raw, couple_terms=couple_terms, couple_scores=couple_scores,

@@ -2,9 +2,11 @@
 
 Couple score
     weighted mean of the five footprint goodnesses and the five trajectory
-    goodnesses (see :mod:`planner._weights`). The 2D score of a couple replaces the
-    3D-only quantities by their best case (jerk goodness 1) and uses the 2D path
-    length and the elevations under the path for the climb, so for every couple
+    goodnesses (see :mod:`planner._weights`). The length goodness is the path's
+    directness on the ground (2D path length against the straight distance to the
+    couple's own footprint), the same in 2D and 3D. The 2D score of a couple
+    replaces the 3D-only quantities by their best case (jerk goodness 1) and uses
+    the elevations under the path for the climb, so for every couple
     ``score_3d <= score_2d``: a 2D score that does not beat the best couple proves
     the 3D one cannot either (§5.2 computes the 2D score first for this reason).
 
@@ -92,7 +94,7 @@ def foot_setup(elevation, ground, forbidden, origin_x, origin_z, offsets, source
                feet_block_radius, w, cfg, slice_size):
     """ROI maps, potential footprints, slices and d_ref of one foot (shared by the search and the
     harvest). Returns (code, elev_dil, boxh_dil, r0, c0, hp, wp, source_p, cand, cand_terms,
-    cand_scores, cand_features, cand_rc, levels, d_ref, cand_xz) - ``cand_xz`` (n, 2) the
+    cand_scores, cand_features, cand_rc, levels, d_ref (n,), cand_xz) - ``cand_xz`` (n, 2) the
     continuous footprints (:func:`planner._kernels_foot.footprint_point`)."""
     cell = cfg[C_CELL]
     radius = cfg[C_RADIUS]
@@ -113,10 +115,23 @@ def foot_setup(elevation, ground, forbidden, origin_x, origin_z, offsets, source
         cand_rc[k, 0] = r0 - 1 + rr
         cand_rc[k, 1] = c0 - 1 + (cand[k] - rr * wp)
     levels = slice_levels(code, boxh_dil, slice_size, cfg[C_SLICE_EPS])
-    # The length goodness's reference: the source -> preferred distance (at least a cell).
-    d_ref = max(math.hypot(pref_x - source[0], pref_z - source[2]), cell)
+    d_ref = directness_references(cand_xz, source[0], source[2], cell)
     return (code, elev_dil, boxh_dil, r0, c0, hp, wp, source_p, cand, cand_terms, cand_scores, cand_features, cand_rc,
             levels, d_ref, cand_xz)
+
+
+@nb.njit(cache=True)
+def directness_references(cand_xz, source_x, source_z, cell):
+    """(n,) the length goodness's reference of each candidate: the straight ground distance from the
+    source to the candidate's own footprint (at least a cell). Measured against the footprint the
+    path ends at, not the preferred one, the term scores how direct a path is and not how short:
+    every swing is longer than a reference to the preferred footprint by its lift, so such a
+    reference rewarded any step shorter than the stride law asks for (strides alternated short and
+    long by up to 30 %)."""
+    out = np.empty(cand_xz.shape[0], dtype=np.float64)
+    for k in range(cand_xz.shape[0]):
+        out[k] = max(math.hypot(cand_xz[k, 0] - source_x, cand_xz[k, 1] - source_z), cell)
+    return out
 
 
 @nb.njit(cache=True)
@@ -156,10 +171,8 @@ def plan_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, 
     for k in range(n_cand - 1, -1, -1):
         for t in range(N_FOOTPRINT_TERMS):
             tb[t] = cand_terms[k, t]
-        straight = math.hypot(cand_xz[k, 0] - source_x, cand_xz[k, 1] - source_z)
         for t in range(N_FOOTPRINT_TERMS, N_TERMS):
-            tb[t] = 1.0
-        tb[N_FOOTPRINT_TERMS] = d_ref / max(straight, d_ref)
+            tb[t] = 1.0  # a straight path (length goodness 1) and perfect others
         ub = weighted_mean(w, tb, 0, N_TERMS)
         suffix_ub[k] = max(ub, suffix_ub[k + 1])
 
@@ -228,13 +241,13 @@ def plan_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, 
             for t in range(N_FOOTPRINT_TERMS):
                 terms[t] = cand_terms[k, t]
             # 2D score: jerk at its best case (goodness 1), 2D length and climb (see module doc).
-            trajectory_goodness(w, terms, d_ref, len2, curv, clear, climb2, 0.0)
+            trajectory_goodness(w, terms, d_ref[k], len2, curv, clear, climb2, 0.0)
             score2 = weighted_mean(w, terms, 0, N_TERMS)
             if mode != MODE_BRUTE_FORCE and score2 <= best_score:
                 continue
             len3, climb3, jerk = couple_metrics_3d(dense, nd, len2, source_y, target_y, step_height,
                                                    cfg[C_OBST_MARGIN], cell, poly, jerk_work)
-            trajectory_goodness(w, terms, d_ref, len3, curv, clear, climb3, jerk)
+            trajectory_goodness(w, terms, d_ref[k], len2, curv, clear, climb3, jerk)
             score3 = weighted_mean(w, terms, 0, N_TERMS)
             counters[CNT_COUPLES_3D] += 1
             evaluated_3d = True
@@ -249,7 +262,7 @@ def plan_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, 
                 improved = True
                 for t in range(N_TERMS):
                     best_terms[t] = terms[t]
-                best_raw[RAW_LENGTH] = len3
+                best_raw[RAW_LENGTH] = len2
                 best_raw[RAW_CURVATURE] = curv
                 best_raw[RAW_CLEARANCE] = clear
                 best_raw[RAW_CLIMB] = climb3
@@ -301,7 +314,7 @@ def harvest_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offset
     """Every candidate couple of one foot (see the module docstring). Returns
 
     (cand_rc (n, 2), cand_xyz (n, 3) target points, cand_features (n, 5) FEAT_* order,
-     cand_terms (n, 5), cand_scores (n,), levels (S,), d_ref, couple_valid (n, S) bool,
+     cand_terms (n, 5), cand_scores (n,), levels (S,), d_ref (n,), couple_valid (n, S) bool,
      couple_raw (n, S, 5) RAW_* order, couple_terms (n, S, 10), couple_scores (n, S, 3)
      SCORE_* order)
 
@@ -363,9 +376,9 @@ def harvest_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offset
                                                    cfg[C_OBST_MARGIN], cell, poly, jerk_work)
             for t in range(N_FOOTPRINT_TERMS):
                 terms[t] = cand_terms[k, t]
-            trajectory_goodness(w, terms, d_ref, len3, curv, clear, climb3, jerk)
+            trajectory_goodness(w, terms, d_ref[k], len2, curv, clear, climb3, jerk)
             couple_valid[k, s] = True
-            couple_raw[k, s, RAW_LENGTH] = len3
+            couple_raw[k, s, RAW_LENGTH] = len2
             couple_raw[k, s, RAW_CURVATURE] = curv
             couple_raw[k, s, RAW_CLEARANCE] = clear
             couple_raw[k, s, RAW_CLIMB] = climb3

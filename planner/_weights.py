@@ -58,7 +58,8 @@ class ScoringWeights(FlatParameters):
     )
     footprint_obstacle_proximity: float = _w("distance to forbidden cells: s = min(1, d / proximity_ref_m)", 1.0)
     # -- trajectory terms (paper §5.2, 'trajectory scoring') -----------------------------
-    trajectory_length: float = _w("short path: s = d_ref / max(length, d_ref), d_ref = source->preferred distance", 2.0)
+    trajectory_length: float = _w("direct path: s = d_ref / max(length, d_ref), length = the ground path's length, d_ref = "
+                                   "source->footprint straight distance", 2.0)
     trajectory_curvature: float = _w(
         "straight path: s = 1 / (1 + E / curvature_energy_ref), E = length * integral kappa^2 ds (horizontal)", 1.0
     )

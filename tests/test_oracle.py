@@ -526,19 +526,18 @@ class Oracle:
         top = y[1:-1].max(initial=-np.inf)
         y[0], y[-1] = source_y, target_y
         poly = np.column_stack([dense[:, 0], y, dense[:, 1]])
-        seg3 = np.linalg.norm(np.diff(poly, axis=0), axis=1)
-        length3d = seg3.sum()
         climb3 = max(0.0, top - base)
         jerk = geometric_jerk(poly)
-        d_ref = max(math.hypot(self.pref_x - self.src_x, self.pref_z - self.src_z), cell)
+        # Directness: the ground path against the straight distance to the couple's own footprint.
+        d_ref = max(math.hypot(cand["point"][0] - self.src_x, cand["point"][1] - self.src_z), cell)
         traj2 = np.array([d_ref / max(length2d, d_ref), 1 / (1 + curvature / w.curvature_energy_ref),
                           min(1.0, clear / w.clearance_ref_m), 1 / (1 + climb2 / w.climb_ref_m), 1.0])
-        traj3 = np.array([d_ref / max(length3d, d_ref), 1 / (1 + curvature / w.curvature_energy_ref),
+        traj3 = np.array([d_ref / max(length2d, d_ref), 1 / (1 + curvature / w.curvature_energy_ref),
                           min(1.0, clear / w.clearance_ref_m), 1 / (1 + climb3 / w.climb_ref_m),
                           1 / (1 + jerk / w.jerk_ref)])
         weights = w.to_array()[:10]
         terms = np.concatenate([cand["terms"], traj3])
-        return dict(raw=(length3d, curvature, clear, climb3, jerk), terms=terms,
+        return dict(raw=(length2d, curvature, clear, climb3, jerk), terms=terms,
                     score=float(weights @ terms / weights.sum()),
                     score_2d=float(weights @ np.concatenate([cand["terms"], traj2]) / weights.sum()), kept=kept)
 
@@ -1000,7 +999,8 @@ def test_hand_trajectory_terms():
     # Flat; a safe (not forbidden) box 2 cm high in cell (0, 2): dilated elevation 0.02 in rows 0..1 x cols
     # 1..3. Step height 0 and obstacle margin 0, so a swing that meets no raised cell stays flat. Slices
     # (5 cm): +inf (over everything) and 0 (around the raised cells (1, 1), (1, 2), (1, 3)).
-    # The foot stands at the centre of (2, 1) = (0.15, 0.25); P = (0.27, 0.25), in (2, 2). d_ref = |P - S| = 0.12.
+    # The foot stands at the centre of (2, 1) = (0.15, 0.25); P = (0.27, 0.25), in (2, 2). d_ref of a candidate is
+    # the straight distance from the source to its own footprint: |P - S| = 0.12 for the footprint P.
     elevation = np.zeros((5, 5))
     elevation[0, 2] = 0.02
     query = FootQuery(source=(0.15, 0.0, 0.25), preferred=(0.27, 0.25), hip=(0.0, 0.25), reach_xz=0.7,
@@ -1008,10 +1008,11 @@ def test_hand_trajectory_terms():
     weights = ScoringWeights(clearance_ref_m=0.25, proximity_ref_m=0.25)
     h = harvest_foot(_hand_maps(elevation, np.zeros((5, 5))), query, weights=weights, budget=EXHAUSTIVE,
                      config=HAND_CONFIG)
-    assert list(h.levels) == [math.inf, 0.0] and h.d_ref == pytest.approx(0.12, abs=HAND_TOL)
+    assert list(h.levels) == [math.inf, 0.0]
     raw_names = ("length", "curvature", "clearance", "climb", "jerk")
 
     k = _row(h, (2, 2))  # footprint P itself, straight swing along z = 0.25
+    assert h.d_ref[k] == pytest.approx(0.12, abs=HAND_TOL)
     raw = dict(zip(raw_names, h.couple_raw[k, 1]))  # slice 0: row 1 is blocked, nothing raised beside the swing
     # length:     |P - S| = 0.27 - 0.15 = 0.12 (flat)                     -> 0.12 / max(0.12, 0.12) = 1
     # curvature:  a straight line turns by 0                             -> 1 / (1 + 0) = 1
@@ -1040,13 +1041,15 @@ def test_hand_trajectory_terms():
     assert h.couple_raw[k, 0, 2] == pytest.approx(0.1, abs=HAND_TOL)
 
     k = _row(h, (2, 3))  # square [0.3, 0.4] x [0.2, 0.3]: footprint (0.3, 0.25), beyond P
-    # length: 0.3 - 0.15 = 0.15 -> 0.12 / 0.15 = 0.8
+    # length: 0.3 - 0.15 = 0.15, straight: d_ref 0.15 -> 0.15 / 0.15 = 1 (a longer step is no less direct;
+    # closeness to P is the distance term's)
     assert h.couple_raw[k, 1, 0] == pytest.approx(0.15, abs=HAND_TOL)
-    assert h.couple_terms[k, 1, 5] == pytest.approx(0.8, abs=HAND_TOL)
+    assert h.d_ref[k] == pytest.approx(0.15, abs=HAND_TOL)
+    assert h.couple_terms[k, 1, 5] == pytest.approx(1.0, abs=HAND_TOL)
     k = _row(h, (3, 3))  # square [0.3, 0.4]^2: footprint the corner (0.3, 0.3)
-    # length: hypot(0.15, 0.05) = 0.15811388300841897 -> 0.12 / 0.158113883 = 0.758946638440411; still straight
+    # length: hypot(0.15, 0.05) = 0.15811388300841897, still straight -> 1
     assert h.couple_raw[k, 1, 0] == pytest.approx(0.15811388300841897, abs=HAND_TOL)
-    assert h.couple_terms[k, 1, 5] == pytest.approx(0.758946638440411, abs=HAND_TOL)
+    assert h.couple_terms[k, 1, 5] == pytest.approx(1.0, abs=HAND_TOL)
     assert abs(h.couple_raw[k, 1, 1]) <= HAND_TOL
 
 

@@ -40,7 +40,7 @@ def jax_scores(harvest):
     tuning.enable_x64()
     w = jnp.asarray(harvest.weights)
     features = harvest.cand_features[:, :, None, :]
-    d_ref = harvest.d_ref[:, None, None]
+    d_ref = harvest.d_ref[:, :, None]
     return {
         "footprint_terms": np.asarray(tuning.footprint_goodness(harvest.cand_features, w)),
         "footprint_score": np.asarray(tuning.footprint_score(harvest.cand_features, w)),

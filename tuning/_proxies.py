@@ -32,9 +32,9 @@ with theta_0 the timing of the harvest: at theta_0 the proxy sees exactly the
 runtime's P. In steady walking the realised step (lift-off to touch-down of one
 foot) is one stride v / f = lambda, symmetric about the rest foot.
 
-P enters the couple score twice: the distance feature d_k = |x_k - P| of every
-candidate (closeness goodness) and the length goodness's reference
-d_ref = max(|P - source|, cell). The expected step length therefore depends on
+P enters the couple score through the candidates' footprints x_k: the distance
+feature d_k = |x_k - P| of every candidate (closeness goodness) and the length
+goodness's reference d_ref,k = max(|x_k - source|, cell). The expected step length therefore depends on
 theta through the probabilities and the continuous footprints: each candidate's
 footprint x_k is its cell's point nearest P (:func:`footprints`, the runtime's
 ``footprint_point``), so it follows P inside its cell; the source and every other
@@ -101,6 +101,7 @@ class Situations(eqx.Module):
     cand_features: jax.Array  # (F, K, 5)
     couple_mask: jax.Array  # (F, K, S) bool
     couple_raw: jax.Array  # (F, K, S, 5)
+    d_ref: jax.Array  # (F, K) the length goodness's reference of each candidate at the harvest's timing
     source: jax.Array  # (F, 3)
     preferred: jax.Array  # (F, 2) at the harvest's timing
     forward: jax.Array  # (F, 2)
@@ -132,7 +133,7 @@ def situations_from_harvest(harvest) -> Situations:
         cand_mask=jnp.asarray(harvest.cand_mask[keep]), cand_xz=f64(harvest.cand_xyz[..., [0, 2]]),
         cand_centre=f64(harvest.cand_centre_xz),
         cand_features=f64(harvest.cand_features), couple_mask=jnp.asarray(harvest.couple_mask[keep]),
-        couple_raw=f64(harvest.couple_raw), source=f64(harvest.source), preferred=f64(harvest.preferred),
+        couple_raw=f64(harvest.couple_raw), d_ref=f64(harvest.d_ref), source=f64(harvest.source), preferred=f64(harvest.preferred),
         forward=f64(harvest.forward), speed=f64(harvest.speed), leg_height=f64(harvest.leg_height),
         relative_swing=f64(harvest.relative_swing), new_swing=jnp.asarray(harvest.kind[keep] != KIND_REPLAN),
         cell_size=f64(harvest.cell_size), creature=jnp.asarray(harvest.creature[keep]),
@@ -194,6 +195,19 @@ def footprints(situations: Situations, pref):
     return jnp.clip(pref[:, None, :], s.cand_centre - half, s.cand_centre + half)
 
 
+def moved_paths(situations: Situations, x):
+    """(d_ref (F, K), raw (F, K, S, 5)) for the candidates' footprints ``x`` (F, K, 2): the length
+    goodness's reference, each candidate's straight distance from the source to its own footprint
+    (planner._kernels_search.directness_references), and the raw metrics with each path's length
+    moved by as much as that distance (a footprint moving inside its cell lengthens or shortens the
+    path's last stretch; its detour is held). Both are the harvest's at theta_0."""
+    s = situations
+    d_ref = jnp.maximum(_norm(x[..., 0] - s.source[:, None, 0], x[..., 1] - s.source[:, None, 2]),
+                        s.cell_size[:, None])
+    raw = s.couple_raw.at[..., RAW_LENGTH].add((d_ref - s.d_ref)[..., None])
+    return d_ref, raw
+
+
 def couple_scores(weights, timing, situations: Situations):
     """(F, K, S) couple scores at weights ``w`` and timing ``theta`` (invalid couples: -inf)."""
     s = situations
@@ -201,8 +215,8 @@ def couple_scores(weights, timing, situations: Situations):
     x = footprints(s, pref)
     d = _norm(x[..., 0] - pref[:, None, 0], x[..., 1] - pref[:, None, 1])
     features = s.cand_features.at[..., FEAT_DISTANCE].set(d)
-    d_ref = jnp.maximum(_norm(pref[:, 0] - s.source[:, 0], pref[:, 1] - s.source[:, 2]), s.cell_size)
-    score = couple_score(features[:, :, None, :], s.couple_raw, d_ref[:, None, None], weights)
+    d_ref, raw = moved_paths(s, x)
+    score = couple_score(features[:, :, None, :], raw, d_ref[:, :, None], weights)
     return jnp.where(s.couple_mask, score, -jnp.inf)
 
 
@@ -245,7 +259,7 @@ def _metrics_under(p, scores, timing, s, clearance_cap_m):
     step = _norm(x[..., 0] - s.source[:, None, 0], x[..., 1] - s.source[:, None, 2])
     ahead = ((x[..., 0] - pref[:, None, 0]) * s.forward[:, None, 0]
              + (x[..., 1] - pref[:, None, 1]) * s.forward[:, None, 1])
-    raw = s.couple_raw
+    _, raw = moved_paths(s, x)
     clearance = raw[..., RAW_CLEARANCE]
     finite = jnp.isfinite(clearance)
     cap = jnp.asarray(clearance_cap_m, dtype=clearance.dtype)

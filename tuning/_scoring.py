@@ -7,7 +7,8 @@ meaning), reading the weights vector ``w = ScoringWeights.to_array()`` through t
 same index constants. Raw inputs are the harvest's (:mod:`planner._harvest`):
 
 * footprint features (..., 5) in ``planner.FEATURES`` order;
-* trajectory metrics (..., 5) in ``planner.RAW_METRICS`` order, and ``d_ref`` (m).
+* trajectory metrics (..., 5) in ``planner.RAW_METRICS`` order, and ``d_ref`` (m): the straight
+  ground distance from the source to the couple's own footprint (the length goodness is directness).
 
 Every function broadcasts over leading axes, is pure, and differentiates with
 respect to ``w`` and the raw numbers. Call it with float64 inputs (``jax_enable_x64``,
