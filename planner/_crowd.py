@@ -140,6 +140,7 @@ class CrowdModel:
     # m/s, the fastest a character walks to get out of the way (of a box, of another): its speed
     # cap, at most Froude number ESCAPE_FROUDE. A box at least this fast cannot be escaped.
     top_speed: float = math.inf
+    height_range: np.ndarray | None = None  # (L, 2) m, least and most pelvis height above each foot (planner._workspace)
 
     @property
     def n_legs(self) -> int:
@@ -268,7 +269,10 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
         direction /= np.maximum(np.hypot(direction[:, 0], direction[:, 1]), 1e-9)[:, None]
     # Reciprocal avoidance (ORCA) of the other characters and of forbidden or moving boxes: the
     # velocity closest to the preferred one that stays clear for the horizon.
-    goal_speed = np.where(arrived, 0.0, np.minimum(state.desired_speed, state.speed_limit))
+    # Arriving: on the last leg of its route a character brakes in time (at its acceleration) to
+    # stop within the arrive radius; braking only once inside it overshot the goal by a metre at a trot.
+    braking = np.where(state.route_index == last, arrival_speed(dist, ctl.arrive_radius, ctl.acceleration), np.inf)
+    goal_speed = np.where(arrived, 0.0, np.minimum(np.minimum(state.desired_speed, state.speed_limit), braking))
     preferred = direction * goal_speed[:, None]
     velocity, avoided = _avoid(model, state, preferred, dist)
     fast = np.hypot(velocity[:, 0], velocity[:, 1]) > 1e-6
@@ -293,6 +297,7 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
     free = ~state.body_held
     state.speed_limit[free] += ctl.limit_recovery * state.desired_speed[free] * dt
     v_des = np.minimum(v_des, np.where(avoided, np.maximum(state.speed_limit, v_des), state.speed_limit))
+    v_des = np.minimum(v_des, braking)
     state.speed = state.speed + np.clip(v_des - state.speed, -ctl.acceleration * dt, ctl.acceleration * dt)
     # Legs that reach: no faster than keeps every stance foot inside its leg's stance window until
     # the needle lifts it (planner._workspace). The cap falls gradually as a foot nears the rear
@@ -371,8 +376,11 @@ def _avoid(model: CrowdModel, state: CrowdState, preferred: np.ndarray, to_targe
 
 def stance_room(model: CrowdModel, state: CrowdState) -> np.ndarray:
     """(C, L) m: how far each foot is in front of the rear end of its leg's stance window."""
-    d = state.feet[..., [0, 2]] - state.pelvis[:, None, [0, 2]]
-    forward = d[..., 0] * np.cos(state.heading)[:, None] + d[..., 1] * np.sin(state.heading)[:, None]
+    from planner._ik import body_rotation
+
+    # Measured along the body's forward axis (the window's own frame): on a slope the body pitches.
+    axis = body_rotation(state.heading, state.pitch, state.roll)[:, :, 0]  # (C, 3)
+    forward = np.einsum("cli,ci->cl", state.feet - state.pelvis[:, None, :], axis)
     return forward - model.stance_window[None, :, 0]
 
 
@@ -443,6 +451,20 @@ def stage_swing(model: CrowdModel, state: CrowdState, boxes) -> np.ndarray:
             landed, state.feet, 0.5 * model.creature.foot_length, 0.5 * model.creature.foot_width, state.foot_yaws,
             centres, sizes, yaws, forbidden)
     return landed
+
+
+def arrival_speed(distance, arrive_radius: float, acceleration: float):
+    """The fastest a character ``distance`` (m) from its goal may walk and still stop, braking at
+    ``acceleration`` (m/s^2), by the time it is ``arrive_radius`` from it: sqrt(2 a (d - r)).
+
+    Examples
+    --------
+    >>> float(arrival_speed(2.3, 0.3, 1.0))   # 2 m to brake in at 1 m/s^2
+    2.0
+    >>> float(arrival_speed(0.2, 0.3, 1.0))
+    0.0
+    """
+    return np.sqrt(2.0 * acceleration * np.maximum(np.asarray(distance, dtype=np.float64) - arrive_radius, 0.0))
 
 
 def travel(speed, goal, acceleration: float, duration):
@@ -643,28 +665,29 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     n_legs = model.n_legs
     map_of = np.full(state.pelvis.shape[0], -1, np.int64)
     map_of[chars] = np.arange(chars.size)
-    freq = frequency[cs]
-    still = freq <= 0.0
-    if still.any():
-        # A body standing (a hold, the first frame) has no tempo: its steps take the swing time of
-        # the walk it will resume. The 1e-3 Hz floor alone gave them the 1 s cap: a foot in the air
-        # for several cycles, re-planned again and again while the body picked up speed.
-        from planner._timing import stride_frequency
+    from planner._timing import stride_frequency
 
-        resume = np.minimum(state.desired_speed[cs][still], state.speed_limit[cs][still])
-        freq = freq.copy()
-        freq[still] = stride_frequency(model.timing, resume, model.leg_height)
-    freq = np.maximum(freq, 1e-3)
+    resume = stride_frequency(model.timing, np.minimum(state.desired_speed[cs], state.speed_limit[cs]),
+                              model.leg_height)
+    # The needle's tempo sets when the foot lifts again (the stance); a body standing (a hold, the
+    # first frame) has none yet and takes the tempo of the walk it will resume.
+    freq = frequency[cs]
+    freq = np.maximum(np.where(freq <= 0.0, resume, freq), 1e-3)
+    # A body standing or speeding up swings with the tempo of the walk it heads for, not of the
+    # speed of the moment: the slow tempo's swing time kept feet in the air for most of a second at
+    # a start (the 0.5 Hz floor at rest) while the needle, speeding up, lifted the other legs: a
+    # spider on one foot, its legs crossing.
+    swing_freq = np.maximum(freq, resume)
     durations = np.asarray(state.gaits.disk_duration)[cs, ls]
     new = kinds[cs, ls] != 3
-    t_swing = np.where(new, np.minimum(durations / freq, 1.0),
+    t_swing = np.where(new, np.minimum(durations / swing_freq, 1.0),
                        np.maximum(state.swing_T[cs, ls] - state.swing_t[cs, ls], 2.0 * model.dt))
     duty = state.gaits.duty_factor[cs]
     nominal = np.where(np.isfinite(duty), duty, 1.0 - durations)
     # The stance lasts until the needle next enters the foot's sector: during a gait transition
     # that is where the sector is heading (the destination start), not the nominal duty factor.
     g = state.gaits
-    landing_phase = g.needle[cs] + np.where(new, durations, t_swing * freq)
+    landing_phase = g.needle[cs] + t_swing * freq  # the sector's end unless the swing is quicker
     until_next = np.mod(g.dest_start[cs, ls] - landing_phase, 1.0)
     t_stance = np.clip(until_next, 0.5 * nominal, 1.5 * nominal) / freq
     heading = state.heading[cs]
@@ -678,14 +701,30 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     spacing = state.feet_spacing[cs]
     # The stance sweep v * T_stance is centred inside the leg's stance window (planner._workspace):
     # a leg whose rest foot sits near an end of its window would run out of reach before lift-off.
-    from planner._workspace import stance_centres
+    from planner._workspace import slope_scale, stance_centres
 
     sweep = travel(v, goal, model.controller.acceleration, t_swing + t_stance) - travel_swing
-    centre = stance_centres(spacing * model.rest_body[ls, 0], model.stance_window[ls], sweep)
-    rx, rz = _rot_xz(heading, centre, spacing * model.rest_body[ls, 1])
-    preferred = pred + np.stack([rx, rz], axis=1) + fwd * (0.5 * sweep)[:, None]
+    # No stance carries a foot further than its leg's window (stance_speed_cap steps it at the rear
+    # end): a longer predicted sweep (a start from rest, whose slow tempo promises a long stance) put
+    # a rear foot half a sweep ahead of its window, in front of the body, across the other legs.
+    window = model.stance_window[ls]
+    sweep = np.minimum(sweep, window[:, 1] - window[:, 0])
+    centre = stance_centres(spacing * model.rest_body[ls, 0], window, sweep)
     hx, hz = _rot_xz(heading, model.hips_body[ls, 0], model.hips_body[ls, 2])
     hip_pred = pred + np.stack([hx, hz], axis=1)
+    # On a slope the ground under a foot is not where it is on flat: a foot at its horizontal rest
+    # offset lands a slope's drop further below its hip on the downhill side (out of reach for a
+    # sprawled leg) and closer on the uphill side. The offset from the hip is scaled so that the
+    # hip-to-foot distance stays the rest one (planner._workspace.slope_scale); a leg under its hip
+    # (a quadruped's) has no offset to scale.
+    offset = np.stack([centre - model.hips_body[ls, 0], spacing * model.rest_body[ls, 1] - model.hips_body[ls, 2]],
+                      axis=1)
+    drop = model.creature.standing_height + model.hips_body[ls, 1]
+    # Kept within [0.5, 1.25]: for a leg nearly under its hip the distance is all drop, and keeping it
+    # would pull a downhill foot under the hip and throw an uphill one far out (legs cross).
+    scale = np.clip(slope_scale(offset, drop, np.tan(state.pitch[cs]), np.tan(state.roll[cs])), 0.5, 1.25)
+    ox, oz = _rot_xz(heading, scale * offset[:, 0], scale * offset[:, 1])
+    preferred = hip_pred + np.stack([ox, oz], axis=1) + fwd * (0.5 * sweep)[:, None]
     foot_yaw = np.arctan2(preferred[:, 1] - hip_pred[:, 1], preferred[:, 0] - hip_pred[:, 0])
     # The other legs at touchdown time: their hips carried forward with the pelvis, their feet
     # where they stand (or will land). Mixing predicted and current hips would make legs
@@ -748,8 +787,9 @@ def stage_pelvis(model: CrowdModel, state: CrowdState) -> None:
     pitch = np.empty_like(y)
     roll = np.empty_like(y)
     pelvis_from_hulls(r.static_top, r.frame.origin_x, r.frame.origin_z, r.frame.cell_size, state.pelvis,
-                      state.heading, support, float(model.creature.body_box[0]), float(model.creature.body_box[1]),
-                      float(model.creature.standing_height), bob, y, pitch, roll, state.hull)
+                      state.heading, support, state.in_stance, float(model.creature.body_box[0]),
+                      float(model.creature.body_box[1]), float(model.creature.standing_height), model.height_range,
+                      float(model.creature.body_thickness), bob, y, pitch, roll, state.hull)
     # A held body (a stance leg at the end of its reach) keeps its whole pose until the leg steps.
     moving = ~state.body_held
     state.pelvis[moving, 1] = y[moving]
@@ -926,7 +966,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         raise ValueError(f"raster: cell size {raster.frame.cell_size} differs from the planner's {config.cell_size}")
     from planner._gait_schedule import as_schedule
     from planner._timing import GRAVITY, hip_height
-    from planner._workspace import speed_cap, stance_windows
+    from planner._workspace import height_ranges, speed_cap, stance_windows
 
     schedule = as_schedule(gait)
     window = stance_windows(creature, rest_body, hips_body, leg_static)
@@ -940,7 +980,8 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         lod_mode=lod_mode, raster=raster, camera=scenario.camera, dt=DT, feet_spacing=spacing,
         hips_body=hips_body, rest_body=rest_body, reach=np.asarray(creature.leg_reach, dtype=np.float64),
         leg_static=leg_static, fixed_budget=budget, schedule=schedule, stance_window=window, speed_cap=cap,
-        speed_asked=speed_asked, step_height=step_height, top_speed=max(escape, speed))
+        speed_asked=speed_asked, step_height=step_height, top_speed=max(escape, speed),
+        height_range=height_ranges(creature, rest_body, hips_body, leg_static))
     rng = np.random.default_rng(seed)
     positions = spawn_positions(scenario, creature, n)
     if scenario.crowd.heading_mode == "random":

@@ -8,6 +8,15 @@ The upper convex hull of those points is the support line; the pelvis sits
 ``standing_height`` above the forward hull at the body centre (plus a bobbing
 from the feet phases); pitch and roll are the slopes of the hull segments under
 the centre.
+
+Legs that reach: the pelvis stands, along the body's up axis, within each leg's height
+range above its foot (:func:`planner._workspace.height_ranges`). On a hill the hull is
+the uphill side and the ground falls away under the downhill feet; a pelvis on the hull
+hung those feet below what their legs reach (holds, a crawl). Where the feet ask for
+more than one height can give, the stance legs' folding wins (a landing point lowers no
+pelvis below what the feet on the ground can fold to). The body never sinks into the
+ground for it: the pelvis stays ``body_thickness`` above the highest ground under the
+body box.
 """
 
 from __future__ import annotations
@@ -59,11 +68,17 @@ def _sample(top, origin_x, origin_z, cell, x, z):
 
 
 @nb.njit(cache=True, parallel=True)
-def pelvis_from_hulls(top, origin_x, origin_z, cell, pelvis, heading, support, body_length, body_width,
-                      standing_height, bob, out_y, out_pitch, out_roll, out_hull):
+def pelvis_from_hulls(top, origin_x, origin_z, cell, pelvis, heading, support, in_stance, body_length, body_width,
+                      standing_height, heights, body_thickness, bob, out_y, out_pitch, out_roll, out_hull):
     """Write pelvis height, pitch, roll and the forward hull height at the centre.
 
-    ``support`` (C, L, 3): the feet used for the hull; ``bob`` (C,) the bobbing offset.
+    ``support`` (C, L, 3): the feet used for the hull; ``in_stance`` (C, L): the feet on the ground
+    (a swinging foot's landing point lowers no pelvis: the stance legs would have to fold for it);
+    ``bob`` (C,) the bobbing offset;
+    ``heights`` (L, 2) m: the least and most the pelvis stands above each leg's foot along its up
+    axis (:func:`planner._workspace.height_ranges`; the least for stance feet only, the most for
+    every support point);
+    ``body_thickness`` (m): the least it stands above the ground under its body box.
     """
     n_chars = pelvis.shape[0]
     n_legs = support.shape[1]
@@ -92,7 +107,31 @@ def pelvis_from_hulls(top, origin_x, origin_z, cell, pelvis, heading, support, b
             yl[3 + i] = support[c, i, 1]
         h, slope = upper_hull_at_zero(s, y, n_legs + 3)
         hl, slope_l = upper_hull_at_zero(t, yl, n_legs + 3)
+        # The paper's hull lies in the sagittal slice (Fig. 4b): all feet projected onto the
+        # heading. On a side slope that slice's upper hull is the uphill feet, a slope's width above
+        # the ground under the body, and the downhill legs cannot reach down that far. The lateral
+        # slice's hull is the ground under the body there (and the sagittal one is on a slope
+        # ahead), so the body stands on the lower of the two.
+        h = min(h, hl)
+        pitch = math.atan(slope)
+        roll = math.atan(slope_l)
+        y_body = h + standing_height + bob[c]
+        # A foot at body offset (f, u, l) lies sp f + cp cr u + cp sr l above the pelvis
+        # (planner._ik.body_rotation), so -u stays within [least, most] while the pelvis is within
+        # foot_y - sp f - cp sr l + cp cr [least, most] (f, l: its ground offsets along the heading).
+        sp = math.sin(pitch)
+        cpcr = math.cos(pitch) * math.cos(roll)
+        cpsr = math.cos(pitch) * math.sin(roll)
+        low = -np.inf
+        for i in range(n_legs):
+            foot = y[3 + i] - sp * s[3 + i] - cpsr * t[3 + i]
+            y_body = min(y_body, foot + cpcr * heights[i, 1])
+            if in_stance[c, i]:
+                low = max(low, foot + cpcr * heights[i, 0])
+        y_body = max(y_body, low)
+        ground = max(max(y[0], y[1]), max(y[2], max(yl[0], yl[2])))
+        y_body = max(y_body, ground + body_thickness)
         out_hull[c] = h
-        out_y[c] = h + standing_height + bob[c]
-        out_pitch[c] = math.atan(slope)
-        out_roll[c] = math.atan(slope_l)
+        out_y[c] = y_body
+        out_pitch[c] = pitch
+        out_roll[c] = roll

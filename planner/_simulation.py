@@ -13,7 +13,7 @@ Metrics are measured after each frame and are not part of the frame time:
 * ``speed_asked`` (the scenario's speed), ``speed_cap`` (the fastest the legs carry at the stride
   law, :mod:`planner._workspace`; ``None`` when no cap applies), ``speed_reached`` (median over
   characters of the pelvis's ground speed over the second half of the run, frames before it
-  reached its goal), ``duty_factor_mean`` (stance fraction of foot-frames after the first
+  braked for its goal, :func:`cruising`), ``duty_factor_mean`` (stance fraction of foot-frames after the first
   second, walking characters), ``gait_fractions`` (share of character-frames in each gait of
   the creature's schedule).
 """
@@ -66,6 +66,11 @@ class SimulationSummary:
     shared_foot_spots: int = 0
     stuck_seconds: float = 0.0
     unavoidable_contacts: int = 0
+    ms_per_frame_warmup: float | None = None
+    """The first frame's ms: a fresh process loads (or, on a cold cache, compiles) the numba kernels
+    there, so it can be 100x a steady frame; ``ms_per_frame_mean`` includes it."""
+    ms_per_frame_steady: float | None = None
+    """Mean ms of the frames after the first: the steady-state cost (None for a one-frame run)."""
 
     def to_json(self) -> dict:
         return asdict(self)
@@ -194,6 +199,17 @@ def arrived(model: CrowdModel, state: CrowdState) -> np.ndarray:
     return (state.route_index == last) & near
 
 
+def cruising(model: CrowdModel, state: CrowdState, goal_speed: np.ndarray) -> np.ndarray:
+    """(C,) characters walking toward their goal and not yet braking for it: not on the last leg of
+    their route, or farther from its end than the arrive radius plus the braking distance of
+    ``goal_speed`` (planner._crowd.arrival_speed)."""
+    ctl = model.controller
+    last = state.route.shape[1] - 1
+    distance = np.hypot(*(state.pelvis[:, [0, 2]] - state.route[:, last]).T)
+    brake = ctl.arrive_radius + goal_speed**2 / (2.0 * ctl.acceleration)
+    return (state.route_index < last) | (distance > brake)
+
+
 def simulate(model: CrowdModel, state: CrowdState, frames: int, recorder: Recorder | None = None,
              progress=None) -> SimulationSummary:
     """Run ``frames`` steps; never raises on a foot that cannot step (it holds)."""
@@ -217,8 +233,9 @@ def simulate(model: CrowdModel, state: CrowdState, frames: int, recorder: Record
         strides.update(k, state, landed)
         walking = ~arrived(model, state)
         if k >= frames // 2:
-            travelled += np.where(walking, np.hypot(*(state.pelvis[:, [0, 2]] - before).T), 0.0)
-            walking_frames += walking
+            cruise = walking & cruising(model, state, strides.goal)
+            travelled += np.where(cruise, np.hypot(*(state.pelvis[:, [0, 2]] - before).T), 0.0)
+            walking_frames += cruise
         if k >= first_second and walking.any():
             stance_feet += int(state.in_stance[walking].sum())
             walking_feet += int(state.in_stance[walking].size)
@@ -250,4 +267,6 @@ def simulate(model: CrowdModel, state: CrowdState, frames: int, recorder: Record
         speed_reached=reached, duty_factor_mean=stance_feet / walking_feet if walking_feet else None,
         body_overlaps=counters.body_overlaps, shared_foot_spots=counters.shared_foot_spots,
         stuck_seconds=counters.stuck_seconds, unavoidable_contacts=counters.unavoidable_contacts,
+        ms_per_frame_warmup=float(frame_ms[0]) if frames else None,
+        ms_per_frame_steady=float(np.mean(frame_ms[1:])) if frames > 1 else None,
         gait_fractions={name: float(n / max(gait_frames.sum(), 1)) for name, n in zip(model.schedule.names, gait_frames)})

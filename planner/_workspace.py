@@ -85,9 +85,26 @@ def stance_windows(creature, rest_body: np.ndarray, hips_body: np.ndarray, legs)
                    lambda: _stance_windows(creature, rest_body, hips_body, legs))
 
 
-def _stance_windows(creature, rest_body, hips_body, legs) -> np.ndarray:
+def _reached(hips_body, legs, leg, targets) -> np.ndarray:
+    """(n,) bool: the IK of leg ``leg[i]`` (joint limits included; level body, body frame) puts its
+    foot on ``targets[i]`` (within :data:`REACH_TOLERANCE`)."""
     from planner._ik import solve_legs
 
+    result = solve_legs(hips_body[leg], np.broadcast_to(np.eye(3), (leg.size, 3, 3)), legs.rest_azimuths[leg],
+                        legs.segment_lengths[leg], legs.limits[leg], legs.azimuth_limits[leg], targets,
+                        max_iterations=48, restarts=8, parallel=True)
+    return result.residual < REACH_TOLERANCE
+
+
+def _rest_feet_reached(rest_body, hips_body, legs, drops) -> np.ndarray:
+    """(L, n) bool: each leg reaches its rest foot with the pelvis ``drops[j]`` (m) above it."""
+    n_legs = rest_body.shape[0]
+    targets = np.stack([np.repeat(rest_body[:, 0], drops.size), np.tile(-drops, n_legs),
+                        np.repeat(rest_body[:, 1], drops.size)], axis=1)
+    return _reached(hips_body, legs, np.repeat(np.arange(n_legs), drops.size), targets).reshape(n_legs, drops.size)
+
+
+def _stance_windows(creature, rest_body, hips_body, legs) -> np.ndarray:
     n_legs = rest_body.shape[0]
     reach = np.asarray(creature.leg_reach, dtype=np.float64)
     height = float(creature.standing_height)
@@ -98,11 +115,7 @@ def _stance_windows(creature, rest_body, hips_body, legs) -> np.ndarray:
     for fraction in WINDOW_HEIGHTS:
         targets = np.stack([forward, np.full_like(forward, -height * (1.0 - fraction)),
                             np.broadcast_to(rest_body[:, 1:2], forward.shape)], axis=-1).reshape(-1, 3)
-        leg = np.repeat(np.arange(n_legs), k)
-        result = solve_legs(hips_body[leg], np.broadcast_to(np.eye(3), (leg.size, 3, 3)), legs.rest_azimuths[leg],
-                            legs.segment_lengths[leg], legs.limits[leg], legs.azimuth_limits[leg], targets,
-                            max_iterations=48, restarts=8, parallel=True)
-        reached &= (result.residual < REACH_TOLERANCE).reshape(n_legs, k)
+        reached &= _reached(hips_body, legs, np.repeat(np.arange(n_legs), k), targets).reshape(n_legs, k)
     windows = np.repeat(rest_body[:, 0:1], 2, axis=1).astype(np.float64)
     middle = k // 2
     for i in range(n_legs):
@@ -179,8 +192,86 @@ def speed_cap(timing, leg_height: float, window: float) -> float:
     return math.sqrt(froude * GRAVITY * leg_height)
 
 
+def slope_scale(offset, drop, slope_forward, slope_left) -> np.ndarray:
+    """Factor ``k`` on a foot's horizontal offset from its hip that keeps the hip-to-foot distance
+    of flat ground on a sloped plane.
+
+    A foot at horizontal offset ``o`` (forward, left; length r) from its hip stands ``drop`` below
+    it on flat ground. On a plane of slopes ``(sf, sl)`` through the ground under the body, the
+    ground at ``k o`` lies ``a k`` lower, ``a = -(sf o_f + sl o_l)``; ``k`` solves
+    ``(k r)^2 + (drop + a k)^2 = r^2 + drop^2``:
+    ``k = (-a drop + sqrt(a^2 drop^2 + r^2 (r^2 + a^2))) / (r^2 + a^2)`` (1 on flat, or for a
+    foot under its hip).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> slope_scale(np.array([[0.0, 0.3], [0.0, -0.3]]), 0.4, 0.0, np.array([0.0, 0.0]))
+    array([1., 1.])
+    >>> k = slope_scale(np.array([[0.0, -0.3]]), 0.4, 0.0, 0.5)   # downhill: a = 0.15
+    >>> float(np.round(k[0], 4)), float(np.round(np.hypot(0.3 * k[0], 0.4 + 0.15 * k[0]), 4))
+    (0.508, 0.5)
+    """
+    offset = np.asarray(offset, dtype=np.float64)
+    a = -(np.asarray(slope_forward) * offset[..., 0] + np.asarray(slope_left) * offset[..., 1])
+    r2 = offset[..., 0] ** 2 + offset[..., 1] ** 2
+    drop = np.asarray(drop, dtype=np.float64)
+    denominator = r2 + a * a
+    with np.errstate(invalid="ignore", divide="ignore"):
+        k = (-a * drop + np.sqrt(a * a * drop * drop + r2 * denominator)) / denominator
+    return np.where(denominator > 1e-12, k, 1.0)
+
+
 STEP_SAMPLES = 41
 """Heights sampled (from the ground up to the standing height) when measuring the highest step."""
+
+
+HEIGHT_SAMPLES = 81
+"""Pelvis heights above a rest foot sampled (0 to 1.5 x the standing height) when measuring a leg's height range."""
+HEIGHT_RANGE_USE = 0.75
+"""Fraction of a leg's reachable height range beyond the standing height the pelvis may use (the rest
+keeps room for a foot away from its rest position)."""
+
+
+def height_ranges(creature, rest_body: np.ndarray, hips_body: np.ndarray, legs) -> np.ndarray:
+    """(L, 2) ``[least, most]`` height (m) of the pelvis above each leg's foot, along the body's up
+    axis, that the pelvis keeps: the contiguous range around the standing height where the leg's IK
+    (joint limits included) reaches its rest foot, :data:`HEIGHT_RANGE_USE` of it on each side of
+    the standing height, and never less than the heights the stance windows are measured at
+    (:data:`WINDOW_HEIGHTS`). A sprawled leg folds and stretches a lot; an upright one little.
+
+    Examples
+    --------
+    >>> from scenarios import load_creature
+    >>> from planner._ik import legs_of
+    >>> q = load_creature("quadruped")
+    >>> r = height_ranges(q, q.rest_feet, q.hips, legs_of(q))
+    >>> bool((r[:, 0] <= 0.95 * q.standing_height + 1e-12).all() and (r[:, 1] >= 1.05 * q.standing_height - 1e-12).all())
+    True
+    """
+    rest_body = np.ascontiguousarray(rest_body, dtype=np.float64)
+    hips_body = np.ascontiguousarray(hips_body, dtype=np.float64)
+    return _cached("heights", creature, rest_body, hips_body, legs,
+                   lambda: _height_ranges(creature, rest_body, hips_body, legs))
+
+
+def _height_ranges(creature, rest_body, hips_body, legs) -> np.ndarray:
+    n_legs = rest_body.shape[0]
+    height = float(creature.standing_height)
+    drops = np.linspace(0.0, 1.5 * height, HEIGHT_SAMPLES)
+    reached = _rest_feet_reached(rest_body, hips_body, legs, drops)
+    out = np.empty((n_legs, 2))
+    standing = int(np.argmin(np.abs(drops - height)))
+    for i in range(n_legs):
+        lo = hi = standing
+        while lo > 0 and reached[i, lo - 1]:
+            lo -= 1
+        while hi < drops.size - 1 and reached[i, hi + 1]:
+            hi += 1
+        least = height - HEIGHT_RANGE_USE * (height - drops[lo]) if reached[i, standing] else height
+        most = height + HEIGHT_RANGE_USE * (drops[hi] - height) if reached[i, standing] else height
+        out[i] = (min(least, height * (1.0 - max(WINDOW_HEIGHTS))), max(most, height * (1.0 - min(WINDOW_HEIGHTS))))
+    return out
 
 
 def highest_step(creature, rest_body: np.ndarray, hips_body: np.ndarray, legs) -> float:
@@ -197,18 +288,10 @@ def highest_step(creature, rest_body: np.ndarray, hips_body: np.ndarray, legs) -
 
 
 def _highest_step(creature, rest_body, hips_body, legs) -> float:
-    from planner._ik import solve_legs
-
     n_legs = rest_body.shape[0]
     height = float(creature.standing_height)
     rises = np.linspace(0.0, height, STEP_SAMPLES)
-    targets = np.stack([np.repeat(rest_body[:, 0], rises.size), np.tile(rises - height, n_legs),
-                        np.repeat(rest_body[:, 1], rises.size)], axis=1)
-    leg = np.repeat(np.arange(n_legs), rises.size)
-    result = solve_legs(hips_body[leg], np.broadcast_to(np.eye(3), (leg.size, 3, 3)), legs.rest_azimuths[leg],
-                        legs.segment_lengths[leg], legs.limits[leg], legs.azimuth_limits[leg], targets,
-                        max_iterations=48, restarts=8, parallel=True)
-    reached = (result.residual < REACH_TOLERANCE).reshape(n_legs, rises.size)
+    reached = _rest_feet_reached(rest_body, hips_body, legs, height - rises)
     best = height
     for i in range(n_legs):
         k = 0

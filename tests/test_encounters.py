@@ -96,9 +96,10 @@ def test_a_crate_driven_across_a_stance_foot_makes_it_step_away_before_contact(t
 
 
 def test_a_crate_crossing_a_planned_swing_replans_it_the_same_frame(tmp_path):
-    # The spider walks +x from (-2, 0) at 0.3 m/s; a 0.3 m crate crosses its path at x = 1,
-    # moving +z at 0.3 m/s from z = -2: it reaches the path as the spider gets there.
-    model, state = _world(tmp_path, "across-swing", crate_centre=(1.0, -2.0), crate_width=0.3, start=(-2.0, 0.0),
+    # The spider walks +x from (-2, 0) at 0.3 m/s; a 0.3 m crate crosses its path at x = 0.5,
+    # moving +z at 0.3 m/s from z = -2: it reaches the path (t = 6.7 s) as the spider's front feet,
+    # 0.3 m ahead of its pelvis, get there.
+    model, state = _world(tmp_path, "across-swing", crate_centre=(0.5, -2.0), crate_width=0.3, start=(-2.0, 0.0),
                           goal=(4.0, 0.0), velocity=(0.0, 0.3))
     blocked = []
 
