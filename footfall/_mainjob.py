@@ -6,6 +6,8 @@
 * ``preset.json``: the creature's weights and timing tuned to the biomechanics targets
   (``footfall tune``), with its provenance and losses;
 * ``report/index.html``: the evaluation sweep (``footfall report``), which also renders the recording;
+* ``clip.mp4``: the recorded crowd walking (the report's clip of the recording, ``footfall render``:
+  bodies and legs from the IK joints, foot tracks, pelvis paths; 30 frames per second);
 * ``scene.usdc``: the crowd walking with the tuned preset, as a USD scene (``footfall export-usd``);
 * ``summary.json``: what each step measured and where its output is.
 
@@ -16,11 +18,12 @@ the outputs of the steps before it.
 from __future__ import annotations
 
 import json
+import shutil
 import tempfile
 import time
 from pathlib import Path
 
-from footfall._atomic import make_folder, write_text_atomic
+from footfall._atomic import atomic_path, make_folder, write_text_atomic
 from footfall._errors import InputError
 
 STEPS = ("simulate", "tune", "report", "export")
@@ -49,7 +52,7 @@ def run_main_job(scenario_name: str, out_dir, *, seed: int = 0, quick: bool = Fa
     from footfall._runs import recorded_run, recording_meta, resolve_gait, say_duty_factor
     from planner._presets import load_preset
     from reports._recording import load_recording
-    from reports._report import build_report
+    from reports._report import CLIP_MAX_FRAMES, build_report
     from reports._usd import export_usd
     from scenarios import DEFAULT_SCENARIO, load_creature, load_scenario
     from tuning._tune import TuneConfig, check_creature, tune
@@ -92,6 +95,16 @@ def run_main_job(scenario_name: str, out_dir, *, seed: int = 0, quick: bool = Fa
                           progress=lambda what, done, total: progress("report", f"{what} ({done}/{total})"))
     summary["report"] = {"recommended_budget": report.get("recommended_budget"),
                          "index": str(out / "report" / "index.html")}
+    # The report has rendered the recording's clip already: the job's clip.mp4 is a copy of it.
+    clip = out / "clip.mp4"
+    rendered = out / "report" / "renders" / "recording" / "clip.mp4"
+    if rendered.is_file():
+        with atomic_path(clip) as tmp:
+            shutil.copyfile(rendered, tmp)
+        summary["clip"] = {"path": str(clip), "frames": min(frames, CLIP_MAX_FRAMES)}
+    else:
+        clip = None
+        summary["clip"] = {"path": None, "error": "; ".join(report.get("render_errors") or ["not rendered"])}
     summary["seconds"]["report"] = time.perf_counter() - t0
 
     t0 = time.perf_counter()
@@ -110,7 +123,8 @@ def run_main_job(scenario_name: str, out_dir, *, seed: int = 0, quick: bool = Fa
 
     summary["seconds"]["total"] = time.perf_counter() - t_job
     summary["outputs"] = {"recording": str(recording), "preset": str(preset_path),
-                          "report": str(out / "report" / "index.html"), "usd": str(scene),
+                          "report": str(out / "report" / "index.html"), "clip": None if clip is None else str(clip),
+                          "usd": str(scene),
                           "summary": str(out / "summary.json")}
     write_text_atomic(out / "summary.json", json.dumps(summary, indent=2))
     return summary

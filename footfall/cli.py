@@ -12,10 +12,17 @@ import sys
 from typing import Optional
 
 import typer
+import typer.core
+import typer.main
 from rich.console import Console
 from rich.table import Table
 
 from footfall._errors import InputError
+
+try:  # typer >= 0.20 carries its own copy of click
+    from typer._click import exceptions as click_exceptions
+except ImportError:  # pragma: no cover - an older typer on plain click
+    from click import exceptions as click_exceptions
 
 app = typer.Typer(no_args_is_help=True, add_completion=False, pretty_exceptions_enable=False,
                   help="footfall: procedural locomotion of multi-legged characters (Abdul Karim et al., CAVW 2012).")
@@ -46,14 +53,54 @@ def _finite(x: float):
     return x if math.isfinite(x) else None
 
 
+LOD_MODES = ("on", "zoomed", "off")
+
+
+def _check_lod(value: str) -> None:
+    """``--lod`` is checked before any work starts, so that its error line is the only output."""
+    if value not in LOD_MODES:
+        raise InputError("argument", "--lod", f"expected one of {', '.join(LOD_MODES)}, got {value!r}")
+
+
 @app.command("scenarios")
 def scenarios_cmd() -> None:
-    """List the built-in scenarios and creatures."""
-    from scenarios import DEFAULT_SCENARIO, builtin_creature_names, builtin_scenario_names
+    """List the built-in scenarios, creatures and gaits, with what each one is."""
+    import tomllib
 
-    out = _stdout()
-    out.print("scenarios: " + ", ".join(f"{n} (default)" if n == DEFAULT_SCENARIO else n for n in builtin_scenario_names()))
-    out.print("creatures: " + ", ".join(builtin_creature_names()))
+    from scenarios import (DEFAULT_SCENARIO, builtin_creature_names, builtin_scenario_names, load_creature, load_gait,
+                           load_scenario)
+    from scenarios._files import CREATURES_DIR
+    from scenarios._gait_schedule import BUILTIN_SCHEDULES
+    from scenarios._gaits import builtin_gait_names, default_gait_name
+
+    lines = ["Scenarios (footfall run|simulate|report|... NAME, or a .toml; NAME@key=value for a variant):"]
+    for name in builtin_scenario_names():
+        s = load_scenario(name)
+        crowd = f"{s.crowd.count} x {s.crowd.creature}"
+        lines.append(f"  {name + (' (default)' if name == DEFAULT_SCENARIO else ''):18} {crowd:12} {s.description}")
+    lines.append("Creatures (--creature NAME, or a .toml):")
+    gait_owner: dict[str, str] = {}
+    for name in builtin_creature_names():
+        c = load_creature(name)
+        with open(CREATURES_DIR / f"{name}.toml", "rb") as fh:
+            description = tomllib.load(fh).get("description", "")
+        lines.append(f"  {name:18} {f'{c.n_legs} legs':12} {description}")
+        gaits = builtin_gait_names(c)
+        for gait in gaits:
+            gait_owner.setdefault(gait, name)
+        if name in BUILTIN_SCHEDULES:
+            names, froude = BUILTIN_SCHEDULES[name]
+            walk = ", then ".join(f"{g} from Fr {f:g}" if k else g
+                                  for k, (g, f) in enumerate(zip(names, (0.0,) + tuple(froude))))
+            lines.append(f"  {'':18} {'':12} gaits by speed: {walk}")
+        else:
+            lines.append(f"  {'':18} {'':12} gait: {default_gait_name(c)}")
+    lines.append("Gaits (--gait NAME, or a .toml; default: the creature's gaits by speed):")
+    for gait in builtin_gait_names():
+        owner = gait_owner.get(gait)
+        description = load_gait(gait, load_creature(owner)).description if owner else ""
+        lines.append(f"  {gait:30} {owner or '':10} {description}")
+    _stdout().print("\n".join(lines), markup=False, soft_wrap=True, highlight=False)
 
 
 @app.command("check")
@@ -65,8 +112,11 @@ def check_cmd(
     speed: Optional[float] = typer.Option(None, help="Speed in m/s for a gait's duty-factor note (default: the "
                                           "scenario's, 0.3 for a gait file)"),
 ) -> None:
-    """Load and validate a scenario, creature or gait file (exit code 2 with one line naming the problem;
-    warnings, e.g. legs whose rest feet could cross, on stderr with exit code 0)."""
+    """Load and validate a scenario, creature or gait file.
+
+    A problem is one line naming the file, the field and the reason, with exit code 2; warnings \
+(e.g. legs whose rest feet could cross) go to stderr with exit code 0.
+    """
     from footfall._runs import duty_factor_note, resolve_gait
     from scenarios import load_creature, load_gait, load_scenario
     from scenarios._creatures import leg_crossing_warnings
@@ -193,8 +243,10 @@ def simulate_cmd(
     say_duty_factor(g, label, authored, c, s.crowd.speed, p.timing if p is not None else None)
     if record is not None and not record.endswith(".npz"):
         raise InputError("argument", "--record", f"expected a .npz path, got {record!r}")
+    _check_lod(lod)
     with Progress(TextColumn("simulating"), BarColumn(), TextColumn("{task.completed}/{task.total} frames"),
-                  TimeRemainingColumn(), console=_err(), transient=True, disable=json_out) as bar:
+                  TimeRemainingColumn(), console=_err(), transient=True,
+                  disable=json_out or not _err().is_terminal) as bar:
         task = bar.add_task("frames", total=frames)
         model, summary, recorder = recorded_run(s, c, g, frames=frames, characters=characters, seed=seed, preset=p,
                                                 lod=lod, record=record is not None,
@@ -238,8 +290,11 @@ def evaluate_cmd(
     strict: bool = typer.Option(False, "--strict", help="Exit 1 when any promise is violated"),
     json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),
 ) -> None:
-    """Check every promise (collisions, crossings, overlaps, slip, IK, stuck, strides, speed) on scenario x
-    creature x seed runs; a table of violations and the exact command that replays each of the worst runs."""
+    """Check every promise on scenario x creature x seed runs; list the violations.
+
+    Promises: collisions, crossings, overlaps, slip, IK, stuck, strides, speed. Prints a table of \
+violations and the exact command that replays each of the worst runs.
+    """
     from pathlib import Path
 
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
@@ -251,8 +306,7 @@ def evaluate_cmd(
     for option, value in (("--seeds", seeds), ("--characters", characters), ("--frames", frames)):
         if value < 1:
             raise InputError("argument", option, f"expected an integer >= 1, got {value}")
-    if lod not in ("on", "zoomed", "off"):
-        raise InputError("argument", "--lod", f"expected one of on, zoomed, off, got {lod!r}")
+    _check_lod(lod)
     check_workers(workers, cluster)
     names = list(scenarios or builtin_scenario_names())
     kinds = [c.strip() for c in creatures.split(",")] if creatures else list(builtin_creature_names())
@@ -267,7 +321,7 @@ def evaluate_cmd(
     err.print(f"seeds: {', '.join(map(str, drawn))}", markup=False)
     total = len(names) * len(kinds) * len(drawn)
     with Progress(TextColumn("evaluate"), BarColumn(), TextColumn("{task.completed}/{task.total} runs"),
-                  TimeElapsedColumn(), console=err, transient=True) as bar:
+                  TimeElapsedColumn(), console=err, transient=True, disable=not err.is_terminal) as bar:
         task = bar.add_task("runs", total=total)
         result = evaluate(names, kinds, drawn, characters=characters, frames=frames, lod=lod, workers=workers,
                           cluster=cluster, progress=lambda _t, done: bar.update(task, completed=done))
@@ -304,23 +358,25 @@ def run_cmd(
     scenario: str = typer.Argument("mixed", help="Built-in scenario name or path to a scenario .toml"),
     out: str = typer.Option("out", "--out", help="Output folder"),
     seed: int = typer.Option(0, help="Seed of every step (same seed, same results; timings aside)"),
-    quick: bool = typer.Option(False, "--quick", help="Short runs and a quick sweep (seconds; for tests)"),
+    quick: bool = typer.Option(False, "--quick", help="Short runs, one tuning round and a quick sweep: a smoke "
+                               "test of the pipeline, not a preset to ship (40-50 s on 2 cores once the kernels "
+                               "are compiled, mostly the tune; a first run compiles them, a few minutes more)"),
     workers: Optional[int] = typer.Option(None, help="Local worker processes of the tune and the report (default: one "
                                           "per core; 1: in-process)"),
     json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),
 ) -> None:
-    """The main job: simulate the scenario's crowd, tune its creature, report, and export a USD scene."""
-    from rich.progress import Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
+    """The main job: simulate the scenario's crowd, tune its creature, report, and export a USD scene.
 
+    Progress goes to stderr: a live line on a terminal, else one line every few seconds with the \
+step and the elapsed time.
+    """
     from footfall._mainjob import STEPS, run_main_job
+    from footfall._progress import Progress
 
-    with Progress(SpinnerColumn(), TextColumn("{task.description}"), TimeElapsedColumn(), console=_err(),
-                  transient=True, disable=json_out) as bar:
-        task = bar.add_task("starting", total=len(STEPS))
+    with Progress("footfall run", enabled=not json_out) as bar:
 
         def progress(step: str, message: str) -> None:
-            bar.update(task, completed=STEPS.index(step), description=f"[{STEPS.index(step) + 1}/{len(STEPS)}] "
-                       f"{step}: {message}")
+            bar.update(f"[{STEPS.index(step) + 1}/{len(STEPS)}] {step}: {message}", step=step)
 
         summary = run_main_job(scenario, out, seed=seed, quick=quick, workers=workers, progress=progress)
     if json_out:
@@ -360,8 +416,11 @@ def export_usd_cmd(
     recording: Optional[str] = typer.Option(None, help="Export this recording (.npz from simulate --record) "
                                             "instead of simulating"),
 ) -> None:
-    """Simulate a small crowd (or take a recording) and write it as a USD scene: terrain, boxes, skinned
-    characters, foot trajectories and footprints."""
+    """Write a crowd run (simulated, or a recording) as a USD scene.
+
+    The scene holds the terrain, the boxes, the skinned characters, the foot trajectories and the \
+footprints. The crowd is the scenario's (its size unless --characters).
+    """
     import tempfile
     from pathlib import Path
 
@@ -394,7 +453,7 @@ def export_usd_cmd(
         p = load_named_preset(preset, c.name) if preset is not None else None
         say_duty_factor(g, label, authored, c, s.crowd.speed, p.timing if p is not None else None)
         with Progress(TextColumn("simulating"), BarColumn(), TextColumn("{task.completed}/{task.total} frames"),
-                      TimeRemainingColumn(), console=_err(), transient=True) as bar:
+                      TimeRemainingColumn(), console=_err(), transient=True, disable=not _err().is_terminal) as bar:
             task = bar.add_task("frames", total=frames)
             model, summary, recorder = recorded_run(s, c, g, frames=frames, characters=characters or s.crowd.count,
                                                     seed=seed,
@@ -405,7 +464,7 @@ def export_usd_cmd(
             recorder.save(path, model, summary, recording_meta(s, seed, "off", g))
             run = load_recording(path)
     with Progress(TextColumn("writing USD"), BarColumn(), TextColumn("{task.completed}/{task.total} parts"),
-                  console=_err(), transient=True) as bar:
+                  console=_err(), transient=True, disable=not _err().is_terminal) as bar:
         task = bar.add_task("parts", total=2 + run.characters)
         written = export_usd(run, s, c, out_path, progress=lambda done, total: bar.update(task, completed=done))
     _stdout().print(f"USD: {written} ({run.characters} x {c.name} on {s.name}, {run.frames} frames)",
@@ -435,7 +494,8 @@ def report_cmd(
     err = _err()
     warnings: list[str] = []
     bar = Progress(TextColumn("report"), BarColumn(), TextColumn("{task.completed}/{task.total}"),
-                   TextColumn("{task.description}"), TimeElapsedColumn(), console=err, transient=True)
+                   TextColumn("{task.description}"), TimeElapsedColumn(), console=err, transient=True,
+                   disable=not err.is_terminal)
     shown = []  # the bar starts with the work, so that refused input prints its one line alone
 
     def progress(what: str, done: int, total: int) -> None:
@@ -517,7 +577,7 @@ def tune_cmd(
     path = check_output(out or f"out/presets/{load_creature(creature).name}.json")
     config = TuneConfig(creature, rounds=rounds, seed=seed, start_timing=_field_values(start_timing, "--start-timing"))
     bar = Progress(TextColumn("tune"), BarColumn(), TextColumn("{task.description}"), TimeElapsedColumn(),
-                   console=_err(), transient=True)
+                   console=_err(), transient=True, disable=not _err().is_terminal)
     with bar:
         task = bar.add_task("starting", total=config.rounds + 2)
         result = tune(config, path, resume=resume, workers=workers, cluster=cluster,
@@ -570,8 +630,10 @@ def bench_tuning_cmd(
     seed: int = typer.Option(0, min=0, help="Seed of the tune and of CMA-ES"),
     json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),
 ) -> None:
-    """Optimistix on the JAX proxies vs CMA-ES on the exact planner: wall time and exact evaluations
-    to reach the same exact loss."""
+    """Optimistix on the JAX proxies vs CMA-ES on the exact planner.
+
+    Wall time and exact evaluations to reach the same exact loss.
+    """
     from benchmarks.tuning_bench import run, table
     from tuning._tune import check_creature
 
@@ -614,16 +676,178 @@ def bench_planner_cmd(
               f"({result['details']['wavefront_grids']} foot grids)")
 
 
-def main(argv: list[str] | None = None) -> None:
+def _option_name(param) -> str:
+    """How the user wrote a parameter: its longest option string (``--frames``), or an argument's name."""
+    opts = [o for o in getattr(param, "opts", ()) if o.startswith("-")]
+    if opts:
+        return max(opts, key=len)
+    return str(getattr(param, "name", None) or "argument").upper()
+
+
+def _sentence(message: str) -> str:
+    """A library's message as the REASON part of an error line: one line, no capital, no full stop."""
+    text = " ".join(str(message).split()).rstrip(".")
+    return text[:1].lower() + text[1:]
+
+
+def usage_error(error: click_exceptions.UsageError) -> InputError:
+    """The :class:`InputError` (``argument: FIELD: REASON``) for a usage error of typer/click's parser.
+
+    Typer validates option values with pydantic; its error, kept as the exception's cause, gives the
+    reason in the words the scenario files use (``must be >= 1``) and the value given.
+    """
+    import difflib
+
+    from pydantic import ValidationError
+
+    if isinstance(error, click_exceptions.MissingParameter):
+        return InputError("argument", _option_name(error.param), "required; see --help")
+    if isinstance(error, click_exceptions.BadParameter):
+        field = _option_name(error.param) if error.param is not None else "argument"
+        cause = error.__cause__
+        if isinstance(cause, ValidationError):
+            from scenarios._schema import pydantic_reason
+
+            first = cause.errors(include_url=False)[0]
+            return InputError("argument", field, f"{pydantic_reason(first)}, got {first.get('input')}")
+        return InputError("argument", field, _sentence(error.message))
+    if isinstance(error, click_exceptions.NoSuchOption):
+        hint = f"; did you mean {' or '.join(sorted(error.possibilities))}?" if error.possibilities else ""
+        where = error.ctx.command_path if error.ctx is not None else "footfall"
+        return InputError("argument", error.option_name, f"no such option of {where}{hint}")
+    if isinstance(error, click_exceptions.BadOptionUsage):
+        reason = _sentence(error.message).removeprefix(f"option {error.option_name!r} ")
+        return InputError("argument", error.option_name, reason)
+    ctx = error.ctx
+    where = ctx.command_path if ctx is not None else "footfall"
+    if ctx is not None and isinstance(ctx.command, typer.core.TyperGroup) and error.message.startswith("No such command"):
+        name = error.message.split("'")[1] if "'" in error.message else ""
+        commands = ctx.command.list_commands(ctx)
+        close = difflib.get_close_matches(name, commands, n=1)
+        hint = f"did you mean {close[0]}?" if close else f"commands are: {', '.join(commands)}"
+        return InputError("argument", name or "COMMAND", f"no such command of {where}; {hint}")
+    if error.message.startswith("Got unexpected extra argument"):
+        extra = error.message.rpartition(" (")[2].rstrip(")")
+        return InputError("argument", extra or where, f"unexpected extra argument of {where}")
+    return InputError("argument", where, _sentence(error.message))
+
+
+def _show_flags_as_flags(command) -> None:
+    """Help lists an on/off option as ``--json``, not ``--json <bool>``: no value follows a flag.
+
+    Typer's help shows every option's type; a flag's metavar, when set, replaces it. Applied to
+    every command, the help option included (it is made on demand, so it is made here).
+    """
+    commands = [command]
+    while commands:
+        cmd = commands.pop()
+        params = list(cmd.params)
+        help_option = cmd.get_help_option(typer.Context(cmd))
+        if help_option is not None:
+            params.append(help_option)
+        for param in params:
+            if getattr(param, "is_flag", False) and param.metavar is None:
+                param.metavar = ""
+        commands.extend(getattr(cmd, "commands", {}).values())
+
+
+def _fail(error: Exception | str, code: int = 2) -> None:
+    """Print the one error line ``footfall: error: ...`` on stderr and exit with ``code``."""
+    _err().print(f"footfall: error: {error}", markup=False, soft_wrap=True)
+    sys.exit(code)
+
+
+@app.command("render")
+def render_cmd(
+    scenario: Optional[str] = typer.Argument(None, help="Built-in scenario name or .toml to simulate and render "
+                                             "(default: mixed; not with --recording)"),
+    out: str = typer.Option(..., "--out", help="Output video: .mp4 (H.264) or .gif"),
+    recording: Optional[str] = typer.Option(None, help="Render this recording (.npz from simulate --record) "
+                                            "instead of simulating"),
+    frames: Optional[int] = typer.Option(None, help="Frames of 1/30 s (default 90 simulated; with --recording: "
+                                         "its first N, default all)"),
+    camera: str = typer.Option("follow", help="follow (the view glides with the crowd) or fixed (one view of the "
+                               "whole run)"),
+    width: int = typer.Option(960, help="Video width, pixels"),
+    height: int = typer.Option(540, help="Video height, pixels"),
+) -> None:
+    """Render a crowd walking into a video (.mp4 or .gif).
+
+    Offscreen, in a subprocess: the creatures' bodies and legs from the IK joints, foot tracks,
+    pelvis paths, footprints, boxes, terrain, a legend and a scale bar."""
+    import tempfile
+    from pathlib import Path
+
+    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
+    from reports._animation import (DEFAULT_SIMULATED_FRAMES, RenderError, check_clip_options, recording_clip_scene,
+                                    render_clip)
+
+    out_path = check_clip_options(out, frames, camera, width, height)
+    if recording is not None and scenario is not None:
+        raise InputError("argument", "--recording", f"renders a finished run: the scenario {scenario!r} cannot "
+                         "change it")
+    err = _err()
+    quiet = not err.is_terminal  # a bar on a pipe or file only leaves blank lines behind
     try:
-        app(args=argv, standalone_mode=True)
-    except InputError as e:
-        _err().print(f"footfall: error: {e}", markup=False, soft_wrap=True)
+        with tempfile.TemporaryDirectory(prefix="footfall-render-") as folder:
+            if recording is None:
+                from footfall._runs import recorded_run, recording_meta, resolve_gait, say_duty_factor
+                from scenarios import load_creature, load_scenario
+
+                s = load_scenario(scenario or "mixed")
+                c = load_creature(s.crowd.creature)
+                g, label, authored = resolve_gait(s, c)
+                say_duty_factor(g, label, authored, c, s.crowd.speed)
+                n = frames or DEFAULT_SIMULATED_FRAMES
+                with Progress(TextColumn("simulating"), BarColumn(), TextColumn("{task.completed}/{task.total} "
+                              "frames"), TimeRemainingColumn(), console=err, transient=True, disable=quiet) as bar:
+                    task = bar.add_task("frames", total=n)
+                    model, summary, recorder = recorded_run(s, c, g, frames=n, progress=lambda k: bar.update(
+                        task, completed=k))
+                recording = str(Path(folder) / "run.npz")
+                recorder.save(recording, model, summary, recording_meta(s, 0, "off", g))
+                frames = None
+            scene = recording_clip_scene(recording, frames)
+            with Progress(TextColumn("rendering"), BarColumn(), TextColumn("{task.completed}/{task.total} frames"),
+                          TimeRemainingColumn(), console=err, transient=True, disable=quiet) as bar:
+                task = bar.add_task("frames", total=len(scene["pelvis"]))
+                result = render_clip(scene, out_path, camera=camera, size=(width, height),
+                                     progress=lambda k, total: bar.update(task, completed=k))
+    except RenderError as e:
+        err.print(f"footfall: error: {out_path}: render: {e}", markup=False, soft_wrap=True)
+        raise typer.Exit(1) from None
+    _stdout().print(f"video: {result['path']} ({result['frames']} frames, {result['seconds']:.2f} s at "
+                    f"{result['fps']:g} fps, {width} x {height}, camera {camera})", markup=False, soft_wrap=True)
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Run the command line.
+
+    Bad input of any kind, from the option parser or from the commands, prints one line
+    ``footfall: error: FILE: FIELD: REASON`` on stderr and exits with code 2 (the parser's own
+    boxed messages are not used); ``footfall`` or ``footfall bench`` alone print their help.
+    """
+    command = typer.main.get_command(app)
+    _show_flags_as_flags(command)
+    try:
+        code = command.main(args=argv, prog_name="footfall", standalone_mode=False)
+    except click_exceptions.NoArgsIsHelpError:
+        # A group called with nothing: typer printed its help while making this error (rich help
+        # prints, then returns ""); the usage-error code, as before.
         sys.exit(2)
+    except click_exceptions.UsageError as e:
+        _fail(usage_error(e))
+    except click_exceptions.ClickException as e:
+        _fail(_sentence(e.format_message()), e.exit_code)
+    except typer.Abort:
+        _fail("aborted", 1)
+    except InputError as e:
+        _fail(e)
     except ValueError as e:
         # Argument validation in the libraries names the argument in its message.
-        _err().print(f"footfall: error: argument: {e}", markup=False, soft_wrap=True)
-        sys.exit(2)
+        _fail(f"argument: {e}")
+    sys.exit(code if isinstance(code, int) else 0)
 
 
 if __name__ == "__main__":

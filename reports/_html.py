@@ -17,8 +17,9 @@ th { background: #f0f0f0; } td:first-child, th:first-child { text-align: left; }
 tr.front td { background: #eef5ff; } tr.recommended td { background: #ffe9a8; font-weight: bold; }
 .box { border: 2px solid #c44e52; padding: 0.6em 1em; background: #fff6f6; }
 .warning { border: 2px solid #d08000; padding: 0.6em 1em; background: #fff4e0; }
-img { max-width: 100%; border: 1px solid #ddd; margin: 0.4em 0; }
+img, video { max-width: 100%; border: 1px solid #ddd; margin: 0.4em 0; }
 .pair { display: grid; grid-template-columns: 1fr 1fr; gap: 1em; }
+figure { margin: 0; } figcaption { font-size: 12px; color: #444; }
 """
 
 
@@ -36,12 +37,14 @@ def _fmt(value) -> str:
     return html.escape(str(value))
 
 
-def _table(rows: list[dict], columns: list[tuple[str, str]], row_class=None) -> str:
-    head = "".join(f'<th title="{html.escape(unit)}">{html.escape(name)}</th>' for name, unit in columns)
+def _table(rows: list[dict], columns: list[tuple[str, ...]], row_class=None) -> str:
+    """An HTML table of ``rows``; ``columns``: (key, unit) or (key, unit, header shown instead of the key)."""
+    head = "".join(f'<th title="{html.escape(column[1])}">{html.escape(column[-1] if len(column) > 2 else column[0])}'
+                   "</th>" for column in columns)
     body = []
     for r in rows:
         cls = row_class(r) if row_class else ""
-        cells = "".join(f"<td>{_fmt(r.get(name))}</td>" for name, _ in columns)
+        cells = "".join(f"<td>{_fmt(r.get(column[0]))}</td>" for column in columns)
         body.append(f'<tr class="{cls}">{cells}</tr>')
     return f"<div class='scroll'><table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table></div>"
 
@@ -49,6 +52,52 @@ def _table(rows: list[dict], columns: list[tuple[str, str]], row_class=None) -> 
 def _img(src: str, alt: str) -> str:
     return f'<img src="{html.escape(src)}" alt="{html.escape(alt)}">'
 
+
+def video(src: str, caption: str) -> str:
+    """A looping, muted clip with its controls (autoplay is allowed only for muted video)."""
+    return (f'<figure><video src="{html.escape(src)}" controls muted loop autoplay playsinline preload="auto" '
+            f'width="640" title="{html.escape(caption)}"></video><figcaption>{html.escape(caption)}</figcaption>'
+            '</figure>')
+
+
+PLOT_CAPTIONS = {
+    "gait_disks_": "One disk per foot at the last frame (paper Fig. 8). The needle (dark red) is the gait's phase, "
+                   "turning clockwise from 12 o'clock; the sector is the part of the cycle in which the foot should "
+                   "be in the air: dark orange if the foot is in the air now, light orange if it is on the ground. "
+                   "* marks a foot in the air outside its sector (a step the controller forced: the foot out of "
+                   "reach or stepping away from a moving box, or a late landing); † a foot on the ground inside its "
+                   "sector (it landed early, or holds because it found no valid footprint yet).",
+    "footprints_": "The candidate footprints of one foot plan (paper Fig. 13), coloured by footprint score over the "
+                   "candidates' own range (the colour bar gives it; every candidate scores well above 0, so a 0-1 "
+                   "scale would show one colour). Black outline: the chosen cell; black line: its trajectory; pink: "
+                   "the best trajectory to other candidates; white dot: the foot now; red x: the preferred footprint "
+                   "(where the gait wants the foot); dark grey: forbidden cells (boxes); the grey background is the "
+                   "ground height (darker = higher; white where it is flat); cells with no colour were not "
+                   "candidates.",
+}
+"""Caption of a scene plot, by the start of its file name."""
+
+
+def plot_caption(src: str) -> str:
+    """What every mark of the plot ``src`` means (:data:`PLOT_CAPTIONS`), or "" for another plot."""
+    name = src.rsplit("/", 1)[-1]
+    return next((text for prefix, text in PLOT_CAPTIONS.items() if name.startswith(prefix)), "")
+
+
+SUMMARY_COLUMNS = [
+    ("setting", "LOD mode, or fixed budget cK-sS: K couples after the first valid one, slices of S m", "setting"),
+    ("paired_cost_vs_first_valid", "planning time per foot / the first valid couple's, all budgets on the same "
+     "requests", "cost (x first valid)"),
+    ("paired_loss_pct", "% of the exhaustive couple score lost, all budgets on the same requests", "loss %"),
+    ("score_loss_pct", "% of the exhaustive couple score lost in the setting's own runs", "own loss %"),
+    ("plan_us_per_foot", "µs per foot plan (own runs, one core)", "µs / foot plan"),
+    ("ms_per_character", "ms per character per frame (median frame)", "ms / character"),
+    ("collisions", "feet in boxes (feet x frames)", "collisions"),
+    ("leg_crossings", "crossing leg pairs (x frames)", "leg crossings"),
+    ("stride_error_median", "median |stride - target| / target", "stride error"),
+    ("on_front", "on the budgets' Pareto front (paired cost vs paired loss)", "on front"),
+]
+"""The short table of the report (at most 10 columns; the full one is behind a toggle and in summary.csv)."""
 
 TASK_COLUMNS = [(n, "") for n in ("scenario", "seed", "setting", "characters", "frames", "ms_per_frame",
                                   "ms_per_character", "plan_us_per_foot", "planner_calls", "cells_per_plan",
@@ -86,17 +135,27 @@ def write_index(path, *, analysis: dict, results: list[dict], meta: dict, scenes
                  "<p>Cost: the planning time per foot relative to the first valid couple's on the same requests "
                  "(timed alternately on one core, so the load of other programs cancels out) and in µs, the crowd's "
                  "median ms per frame and per character, planner calls, wavefront cells expanded. Each setting's own "
-                 "runs give its row; for the fixed budgets the paired_* columns come from every budget planning the "
-                 "same requests (those of a no-LOD crowd): the Pareto front and the recommendation use these. "
+                 "runs give its row; for the fixed budgets the cost and loss % columns (paired_* in the full table) come "
+                 "from every budget planning the same requests (those of a no-LOD crowd): the Pareto front and the "
+                 "recommendation use these; own loss % is from the setting's own runs. "
                  "Frame timings move with the load of the machine. Quality: the couple-score deficit against the exhaustive search "
                  "(planner.EXHAUSTIVE: no couple limit, 5 cm slices, exact stop) on the same situations, "
                  "collisions, forbidden footprints, leg crossings, stride length error against "
                  "λ = 2.3 h Fr<sup>0.3</sup>, curvature energy E = l ∫κ² ds of the swing paths (horizontal, "
                  "u in [0.05, 0.95]) and the IK residual. Blue rows: on the budgets' Pareto front; yellow: recommended. "
-                 "Hover a column name for its unit.</p>")
+                 "Hover a column name for its unit. The short table below has the figures that decide; "
+                 "<i>All columns</i> opens the full one.</p>")
     columns = [(n, u) for n, _, u in COLUMNS]
-    parts.append(_table(rows, columns[:4] + list(PAIRED_COLUMNS) + columns[4:] + [("on_front", "")],
-                        lambda r: "recommended" if r["recommended"] else ("front" if r["on_front"] else "")))
+
+    def row_class(r: dict) -> str:
+        return "recommended" if r["recommended"] else ("front" if r["on_front"] else "")
+
+    parts.append(_table(rows, SUMMARY_COLUMNS, row_class))
+    every_column = columns[:4] + list(PAIRED_COLUMNS) + columns[4:] + [("on_front", "")]
+    parts.append(f"<details><summary>All {len(every_column)} columns (also in <a href='summary.csv'>summary.csv</a>)"
+                 "</summary>")
+    parts.append(_table(rows, every_column, row_class))
+    parts.append("</details>")
     parts.append(_img("pareto.png", "quality vs cost Pareto front"))
     parts.append("<h2>Stride length vs speed</h2><p>Every pair of consecutive touch-downs of a foot in the "
                  "measured frames: the distance between the two footprints against the pelvis speed over that time; "
@@ -109,8 +168,10 @@ def write_index(path, *, analysis: dict, results: list[dict], meta: dict, scenes
         parts.append(f"<h2>Scenario {html.escape(s['scenario'])}</h2>")
         parts.append(f"<p>{html.escape(s['caption'])}</p><div class='pair'>")
         for src, alt in s["plots"]:
-            parts.append(f"<div>{_img(src, alt)}</div>")
+            parts.append(f"<figure>{_img(src, alt)}<figcaption>{html.escape(plot_caption(src))}</figcaption></figure>")
         parts.append("</div>")
+        if s.get("clip"):
+            parts.append(video(s["clip"], f"{s['scenario']}: the crowd walking (30 frames per second)"))
         if s["renders"]:
             parts.append("<div class='pair'>" + "".join(f"<div>{_img(src, alt)}</div>" for src, alt in s["renders"])
                          + "</div>")
@@ -118,6 +179,8 @@ def write_index(path, *, analysis: dict, results: list[dict], meta: dict, scenes
             parts.append(f"<p class='warning'>3D rendering failed: {html.escape(s['render_error'])}</p>")
     if recording is not None:
         parts.append(f"<h2>Recording {html.escape(recording['name'])}</h2><p>{html.escape(recording['caption'])}</p>")
+        if recording.get("clip"):
+            parts.append(video(recording["clip"], f"{recording['name']}: the crowd walking (30 frames per second)"))
         if recording["renders"]:
             parts.append("<div class='pair'>" + "".join(f"<div>{_img(src, alt)}</div>"
                                                          for src, alt in recording["renders"]) + "</div>")

@@ -17,8 +17,8 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Circle, Rectangle, Wedge
 
 DPI = 110
-# Paper Fig. 13: green = best target (score 1), blue = worst (score 0).
-SCORE_COLOURS = LinearSegmentedColormap.from_list("footprint_score", ["#1f3fbf", "#1fbf3f"])
+# Paper Fig. 13: green = best target, blue = worst; a cyan middle keeps neighbouring scores apart.
+SCORE_COLOURS = LinearSegmentedColormap.from_list("footprint_score", ["#1f3fbf", "#2aa7c9", "#7ddc3a"])
 
 
 def _save(fig: Figure, path) -> None:
@@ -105,76 +105,183 @@ def _phase_angle(phase):
     return 90.0 - 360.0 * np.asarray(phase)
 
 
+SWING_NOW = "#e4572e"  # the sector of a foot in the air now
+SWING_LATER = "#f6c3a8"  # the sector of a foot on the ground now
+NEEDLE = "#8b0000"
+
+
+def gait_disk_states(scene: dict) -> list[str]:
+    """Per foot, how its state at the snapshot relates to its disk (paper Fig. 8).
+
+    ``"swing"``: in the air, the needle in its sector; ``"stance"``: on the ground, the needle
+    outside. The two others are not errors of the plot: ``"forced"``, in the air with the needle
+    outside its sector (a step the controller forced: the foot out of reach, or stepping away from
+    a moving box, or a swing that lands late); ``"hold"``, on the ground with the needle inside its
+    sector (the foot landed early, or holds because no valid footprint was found yet).
+    """
+    needle = float(scene["gait_needle"])
+    states = []
+    for start, duration, on_ground in zip(scene["gait_start"], scene["gait_duration"], scene["gait_in_stance"]):
+        inside = (needle - float(start)) % 1.0 < float(duration)
+        if on_ground:
+            states.append("hold" if inside else "stance")
+        else:
+            states.append("swing" if inside else "forced")
+    return states
+
+
+GAIT_STATE_TITLES = {"swing": "in the air", "stance": "on the ground", "forced": "in the air *",
+                     "hold": "on the ground †"}
+
+
 def gait_disks(scene: dict, path) -> None:
-    """One disk per foot: the swing sector coloured, the needle in red (paper Fig. 8)."""
+    """One disk per foot, its swing sector and the needle (paper Fig. 8), with a legend.
+
+    The sector is the part of the cycle in which the foot should be in the air; it is dark when
+    the foot is in the air at the snapshot, light when it is on the ground. The marks * and †
+    flag a foot off its schedule (:func:`gait_disk_states`).
+    """
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
     names = scene["leg_names"]
     n = len(names)
     cols = min(n, 4) if n <= 4 else math.ceil(n / 2)
     rows = math.ceil(n / cols)
-    fig = Figure(figsize=(2.0 * cols, 2.1 * rows + 0.5), layout="constrained")
+    fig = Figure(figsize=(2.0 * cols, 2.1 * rows + 1.1), layout="constrained")
     axes = np.atleast_1d(fig.subplots(rows, cols)).ravel()
     needle = scene["gait_needle"]
+    states = gait_disk_states(scene)
     for i, ax in enumerate(axes):
         ax.set_aspect("equal")
         ax.axis("off")
         if i >= n:
             continue
         start, duration = float(scene["gait_start"][i]), float(scene["gait_duration"][i])
-        swinging = not bool(scene["gait_in_stance"][i])
+        in_air = states[i] in ("swing", "forced")
         ax.add_patch(Circle((0, 0), 1.0, fc="#f2f2f2", ec="k", lw=1.2))
         ax.add_patch(Wedge((0, 0), 1.0, _phase_angle(start + duration), _phase_angle(start),
-                           fc="#e4572e" if swinging else "#76b041", ec="k", lw=0.8))
+                           fc=SWING_NOW if in_air else SWING_LATER, ec="k", lw=0.8))
         a = math.radians(float(_phase_angle(needle)))
-        ax.plot([0, 0.95 * math.cos(a)], [0, 0.95 * math.sin(a)], c="#c00000", lw=2.2)
+        ax.plot([0, 0.95 * math.cos(a)], [0, 0.95 * math.sin(a)], c=NEEDLE, lw=2.2)
         ax.add_patch(Circle((0, 0), 0.06, fc="k"))
         ax.set_xlim(-1.15, 1.15)
         ax.set_ylim(-1.15, 1.15)
-        ax.set_title(f"{names[i]} ({'swing' if swinging else 'stance'})", fontsize=9)
-    fig.suptitle(f"Gait manager: {scene['creature']}, gait {scene['gait_name']} (sector = swing phase, orange = swinging now, "
-                 "red = needle)",
-                 fontsize=10)
+        ax.set_title(f"{names[i]}: {GAIT_STATE_TITLES[states[i]]}", fontsize=9)
+    handles = [Patch(fc=SWING_NOW, ec="k", label="swing sector, foot in the air now"),
+               Patch(fc=SWING_LATER, ec="k", label="swing sector, foot on the ground now"),
+               Line2D([], [], c=NEEDLE, lw=2.2, label="needle: the gait's phase now (clockwise from 12)")]
+    notes = []
+    if "forced" in states:
+        notes.append("* in the air outside its sector: a forced step (out of reach, away from a moving box) "
+                     "or a late landing")
+    if "hold" in states:
+        notes.append("† on the ground inside its sector: landed early, or holds (no valid footprint yet)")
+    fig.legend(handles=handles, loc="outside lower center", ncols=3, fontsize=7, frameon=False)
+    fig.suptitle(f"Gait manager: {scene['creature']}, gait {scene['gait_name']}" + "".join(f"\n{t}" for t in notes),
+                 fontsize=9)
     _save(fig, path)
 
 
+def chosen_cell(h: dict) -> int | None:
+    """Index of the candidate cell the plan chose (the one its trajectory ends in), or None."""
+    cells = np.asarray(h["cells_xz"], dtype=np.float64)
+    if not len(cells) or not len(h["chosen"]):
+        return None
+    end = np.asarray(h["chosen"])[-1, [0, 2]]
+    k = int(np.argmin(np.hypot(*(cells - end).T)))
+    return k if np.all(np.abs(cells[k] - end) <= 0.5 * h["cell_size"] + 1e-9) else None
+
+
+def score_range(scores) -> tuple[float, float]:
+    """The colour range of the footprint scores: the candidates' own range, never empty."""
+    lo, hi = float(np.min(scores)), float(np.max(scores))
+    if hi - lo < 1e-6:
+        lo, hi = lo - 0.005, hi + 0.005
+    return lo, hi
+
+
 def footprint_heatmap(scene: dict, path) -> None:
-    """Candidate cells coloured by footprint score, trajectories in pink, the chosen one in black."""
+    """One foot plan's candidate footprints, coloured by score over the candidates' own range (Fig. 13).
+
+    Marks: the chosen cell outlined in black, its trajectory in black, the best trajectories
+    to other candidates in pink, the foot now (white dot), the preferred footprint (red x),
+    forbidden cells (dark grey) over the ground height (grey, darker = higher). Cells with no
+    colour were not candidates (outside the search disc, or refused).
+    """
+    from matplotlib.colors import Normalize
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
     h = scene["heatmap"]
     cell = h["cell_size"]
-    fig = Figure(figsize=(6.4, 5.6), layout="constrained")
+    fig = Figure(figsize=(7.0, 6.4), layout="constrained")
     ax = fig.subplots()
     cells = h["cells_xz"]
+    scores = np.asarray(h["scores"], dtype=np.float64)
     pts = np.vstack([cells, h["source"][None, [0, 2]], h["preferred"][None, :], h["chosen"][:, [0, 2]]])
     lo = pts.min(axis=0) - 4 * cell
     hi = pts.max(axis=0) + 4 * cell
     elev = h["elevation"]
     extent = (h["origin"][0], h["origin"][0] + elev.shape[1] * cell, h["origin"][1], h["origin"][1] + elev.shape[0] * cell)
-    ax.imshow(elev, origin="lower", extent=extent, cmap="Greys", alpha=0.55, interpolation="nearest")
+    low, high = _visible(elev, extent, lo, hi)
+    flat = high - low < 1e-3  # one shade (white) for flat ground, not a grey of no meaning
+    ax.imshow(elev, origin="lower", extent=extent, cmap="Greys", alpha=0.55, interpolation="nearest",
+              vmin=low, vmax=low + 1.0 if flat else high)
+    ground = (f"ground height: flat here ({low:.2f} m)" if flat
+              else f"ground height, darker = higher ({low:.2f}-{high:.2f} m)")
     for x, z in h["forbidden_xz"]:
         if lo[0] <= x <= hi[0] and lo[1] <= z <= hi[1]:
             ax.add_patch(Rectangle((x - cell / 2, z - cell / 2), cell, cell, fc="#404040", ec="none"))
-    for (x, z), s in zip(cells, h["scores"]):
-        ax.add_patch(Rectangle((x - cell / 2, z - cell / 2), cell, cell, fc=SCORE_COLOURS(float(s)), ec="w", lw=0.3))
+    norm = Normalize(*score_range(scores))
+    for (x, z), s in zip(cells, scores):
+        ax.add_patch(Rectangle((x - cell / 2, z - cell / 2), cell, cell, fc=SCORE_COLOURS(norm(float(s))), ec="w",
+                               lw=0.3))
+    pick = chosen_cell(h)
+    if pick is not None:
+        x, z = cells[pick]
+        ax.add_patch(Rectangle((x - cell / 2, z - cell / 2), cell, cell, fc="none", ec="k", lw=2.6, zorder=4))
     for traj in h["others"]:
         ax.plot(traj[:, 0], traj[:, 2], c="#ff69b4", lw=1.2, alpha=0.9)
-    ax.plot(h["chosen"][:, 0], h["chosen"][:, 2], c="k", lw=2.4, label="chosen trajectory")
-    ax.plot([], [], c="#ff69b4", label="trajectories to other candidates")
-    ax.scatter([h["source"][0]], [h["source"][2]], marker="o", s=60, c="w", edgecolors="k", zorder=5, label="foot now")
-    ax.scatter([h["preferred"][0]], [h["preferred"][1]], marker="x", s=70, c="#c00000", zorder=5,
-               label="preferred footprint")
+    ax.plot(h["chosen"][:, 0], h["chosen"][:, 2], c="k", lw=2.4)
+    ax.scatter([h["source"][0]], [h["source"][2]], marker="o", s=60, c="w", edgecolors="k", zorder=5)
+    ax.scatter([h["preferred"][0]], [h["preferred"][1]], marker="x", s=70, c="#c00000", zorder=5)
     ax.set_xlim(lo[0], hi[0])
     ax.set_ylim(lo[1], hi[1])
     ax.set_aspect("equal")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("z (m)")
-    sm = fig.colorbar(_scalar_mappable(), ax=ax, shrink=0.8)
-    sm.set_label("footprint score (green 1, blue 0)")
-    ax.set_title(f"Potential footprints: {len(cells)} candidates, couple score {h['couple_score']:.3f}", fontsize=10)
-    ax.legend(fontsize=7, loc="upper left")
+    bar = fig.colorbar(_scalar_mappable(norm), ax=ax, shrink=0.8)
+    bar.set_label(f"footprint score (colours span the candidates' range, {norm.vmin:.3f}-{norm.vmax:.3f})")
+    chosen_score = f" (score {scores[pick]:.3f})" if pick is not None else ""
+    handles = [Patch(fc="none", ec="k", lw=2.6, label=f"chosen footprint{chosen_score}"),
+               Line2D([], [], c="k", lw=2.4, label="chosen trajectory"),
+               Line2D([], [], c="#ff69b4", lw=1.2, label="best trajectories to other candidates"),
+               Line2D([], [], ls="none", marker="o", ms=7, mfc="w", mec="k", label="foot now"),
+               Line2D([], [], ls="none", marker="x", ms=8, mec="#c00000", label="preferred footprint"),
+               Patch(fc="#404040", label="forbidden cell (box)"),
+               Patch(fc="w" if flat else "#c8c8c8", ec="#bbbbbb", label=ground),
+               Patch(fc="none", ec="#bbbbbb", label="no colour: not a candidate")]
+    fig.legend(handles=handles, loc="outside lower center", ncols=2, fontsize=7, frameon=False)
+    ax.set_title(f"Potential footprints of one foot plan: {len(cells)} candidates scoring "
+                 f"{scores.min():.3f}-{scores.max():.3f}; couple score {h['couple_score']:.3f}", fontsize=9)
     _save(fig, path)
 
 
-def _scalar_mappable():
+def _visible(elev: np.ndarray, extent, lo, hi) -> tuple[float, float]:
+    """Lowest and highest ground height inside the plotted window (the grey scale spans them)."""
+    ny, nx = elev.shape
+    xs = np.linspace(extent[0], extent[1], nx, endpoint=False) + (extent[1] - extent[0]) / (2 * nx)
+    zs = np.linspace(extent[2], extent[3], ny, endpoint=False) + (extent[3] - extent[2]) / (2 * ny)
+    inside = elev[np.ix_((zs >= lo[1]) & (zs <= hi[1]), (xs >= lo[0]) & (xs <= hi[0]))]
+    values = inside[np.isfinite(inside)] if inside.size else elev[np.isfinite(elev)]
+    if not values.size:
+        return 0.0, 0.0
+    return float(values.min()), float(values.max())
+
+
+def _scalar_mappable(norm=None):
     from matplotlib.cm import ScalarMappable
     from matplotlib.colors import Normalize
 
-    return ScalarMappable(norm=Normalize(0.0, 1.0), cmap=SCORE_COLOURS)
+    return ScalarMappable(norm=norm or Normalize(0.0, 1.0), cmap=SCORE_COLOURS)

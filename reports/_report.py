@@ -12,13 +12,9 @@ import dataclasses
 import json
 import os
 import shutil
-import subprocess
-import sys
 import tempfile
 import time
 from pathlib import Path
-
-import numpy as np
 
 from footfall._atomic import make_folder
 from footfall._errors import InputError
@@ -27,9 +23,10 @@ from reports import _html, _pareto, _plots, _sweep
 
 REPORT_FORMAT = "footfall-report"
 REPORT_VERSION = 1
-RENDER_TIMEOUT_S = 180
-SCENE_ARRAYS = ("terrain_heights", "terrain_origin", "terrain_cell", "box_centres", "box_sizes", "box_yaws",
-                "box_forbidden", "feet", "pelvis", "footprints")
+CLIP_SIZE = (640, 360)
+CLIP_MIN_FRAMES = 60
+"""Every clip of the report has at least this many frames (2 s), the quick sweep's scenes too."""
+CLIP_MAX_FRAMES = 300
 
 
 def _writable_out(out: Path) -> None:
@@ -80,53 +77,48 @@ def load_recording(path) -> dict:
     rec = load_validated(path)
     if not rec.header.get("scenario"):
         raise InputError(str(path), "header.scenario", "missing: the recording does not name its scenario")
-    return {"header": rec.header, "feet": rec.feet, "pelvis": rec.pelvis, "in_stance": rec.in_stance}
+    return {"header": rec.header, "feet": rec.feet, "pelvis": rec.pelvis, "in_stance": rec.in_stance,
+            "recording": rec}
 
 
-def _recording_scene(recording: dict, max_characters: int = 10) -> dict:
-    from scenarios import load_scenario
+def render_run(recording, out_dir: Path, *, max_characters: int = 10) -> tuple[list[str], str | None, str | None]:
+    """Pictures and a clip of a recorded run, rendered in subprocesses (a VTK crash must not end the
+    report): (PNG names, clip name or None, error or None). The creatures are drawn from the
+    recording's IK joints (:mod:`reports._animation`); at most ``max_characters`` of them and the
+    first :data:`CLIP_MAX_FRAMES` frames."""
+    from reports._animation import RenderError, recording_scene, render_clip, render_stills
+    from scenarios import load_creature, load_scenario
 
-    header = recording["header"]
-    scenario = load_scenario(header["scenario"])
-    feet = recording["feet"].astype(np.float64)[:, :max_characters]
-    stance = recording["in_stance"][:, :max_characters]
-    down = np.zeros_like(stance)
-    down[1:] = stance[1:] & ~stance[:-1]
-    f, c, leg = np.nonzero(down)
-    centres, yaws = scenario.obstacles.poses_at(feet.shape[0] * float(header["dt"]))
-    t = scenario.terrain
-    return {"scenario": scenario.name, "terrain_heights": np.asarray(t.heights),
-            "terrain_origin": np.array([t.origin_x, t.origin_z]), "terrain_cell": float(t.cell_size),
-            "box_centres": np.asarray(centres, np.float64).reshape(-1, 3),
-            "box_sizes": np.asarray(scenario.obstacles.sizes, np.float64).reshape(-1, 3),
-            "box_yaws": np.asarray(yaws, np.float64).reshape(-1),
-            "box_forbidden": np.asarray(scenario.obstacles.forbidden, bool).reshape(-1),
-            "feet": feet, "pelvis": recording["pelvis"].astype(np.float64)[:, :max_characters],
-            "footprints": feet[f, c, leg]}
-
-
-def render_scene(scene: dict, out_dir: Path, work: Path) -> tuple[list[str], str | None]:
-    """Render in a subprocess (a VTK crash must not end the report): (PNG names, error or None)."""
     out_dir.mkdir(parents=True, exist_ok=True)
-    npz = work / f"scene-{len(list(work.iterdir()))}.npz"
-    np.savez(npz, **{k: np.asarray(scene[k]) for k in SCENE_ARRAYS})
-    env = dict(os.environ, VTK_DEFAULT_OPENGL_WINDOW="vtkEGLRenderWindow")
+    if recording.frames > CLIP_MAX_FRAMES:
+        recording = recording.head(CLIP_MAX_FRAMES)
     try:
-        proc = subprocess.run([sys.executable, "-m", "reports._render", str(npz), str(out_dir)], env=env,
-                              capture_output=True, text=True, timeout=RENDER_TIMEOUT_S)
-    except subprocess.TimeoutExpired:
-        return [], f"the renderer did not finish in {RENDER_TIMEOUT_S} s"
-    if proc.returncode != 0:
-        tail = (proc.stderr.strip().splitlines() or [""])[-1]
-        return [], f"the renderer exited with code {proc.returncode}" + (f": {tail}" if tail else "")
+        scene = recording_scene(recording, load_scenario(recording.scenario), load_creature(recording.creature),
+                                max_characters)
+    except InputError as e:  # e.g. a creature file that is not at hand: the report goes on without pictures
+        return [], None, f"cannot draw the run: {e}"
     try:
-        names = json.loads(proc.stdout.strip().splitlines()[-1])
-    except (ValueError, IndexError):
-        return [], "the renderer printed no file list"
-    missing = [n for n in names if not (out_dir / n).is_file()]
-    if missing:
-        return [], f"the renderer did not write {', '.join(missing)}"
-    return names, None
+        names = render_stills(scene, out_dir)
+    except RenderError as e:
+        return [], None, str(e)
+    try:
+        render_clip(scene, out_dir / "clip.mp4", camera="follow", size=CLIP_SIZE)
+    except RenderError as e:
+        return names, None, str(e)
+    return names, "clip.mp4", None
+
+
+def _scene_recording(name: str, seed: int, characters: int, frames: int, work: Path):
+    """A recorded run of the scenario's crowd for its pictures and clip (no LOD, default weights)."""
+    from footfall._runs import recorded_run, recording_meta
+    from reports._recording import load_recording as load_validated
+
+    scenario, creature, gait = _sweep._load_inputs(name)
+    model, summary, recorder = recorded_run(scenario, creature, gait, frames=frames, characters=characters,
+                                            seed=seed)
+    path = work / f"clip-{len(list(work.iterdir()))}.npz"
+    recorder.save(path, model, summary, recording_meta(scenario, seed, "off", gait))
+    return load_validated(path)
 
 
 def _write_csv(path: Path, rows: list[dict], columns: list[str]) -> None:
@@ -206,32 +198,37 @@ def build_report(out, *, preset: str = "default", scenarios: tuple[str, ...] | N
                     _plots.footprint_heatmap(scene, tmp / plots[-1][0])
                     caption += ("Footprint scores of the plan with the most candidates (paper Fig. 13), planned "
                                 "again from its captured request; pink: the best trajectory to other candidates. ")
-                caption += "3D: terrain, boxes (red forbidden, tan safe), foot tracks by leg, footprints in white."
+                clip_frames = min(max(CLIP_MIN_FRAMES, options.scene_frames), CLIP_MAX_FRAMES)
+                caption += (f"3D pictures and clip: another run of the same crowd, {clip_frames} frames "
+                            f"({clip_frames / 30:.0f} s), the creatures drawn from their IK joints, one colour "
+                            "per character; the legend and the scale bar are in the pictures.")
                 progress(f"rendering {name}", done, total)
-                names, error = render_scene(scene, tmp / "renders" / sname, work)
+                clip_run = _scene_recording(name, int(seed), options.scene_characters, clip_frames, work)
+                names, clip, error = render_run(clip_run, tmp / "renders" / sname)
                 done += 1
                 if error:
                     warn(f"rendering {sname} failed: {error}")
                     render_errors.append(error)
                 scene_notes.append({"scenario": sname, "renders": [f"renders/{sname}/{n}" for n in names],
+                                    "clip": f"renders/{sname}/{clip}" if clip else None,
                                     "heatmap_matches_crowd": (scene["heatmap"] or {}).get("matches_crowd")})
                 scenes.append({"scenario": sname, "caption": caption, "plots": plots,
                                "renders": [(f"renders/{sname}/{n}", f"{sname}: {n}") for n in names],
-                               "render_error": error})
+                               "clip": f"renders/{sname}/{clip}" if clip else None, "render_error": error})
             rec_page = None
             if rec is not None:
                 progress("rendering the recording", done, total)
-                scene = _recording_scene(rec)
-                names, error = render_scene(scene, tmp / "renders" / "recording", work)
+                names, clip, error = render_run(rec["recording"], tmp / "renders" / "recording")
                 done += 1
                 if error:
                     warn(f"rendering the recording failed: {error}")
                     render_errors.append(error)
                 h = rec["header"]
                 rec_page = {"name": Path(recording).name, "renders": [(f"renders/recording/{n}", n) for n in names],
-                            "render_error": error,
+                            "clip": f"renders/recording/{clip}" if clip else None, "render_error": error,
                             "caption": f"{h.get('creature')} on {h['scenario']}, {rec['feet'].shape[0]} frames, "
-                                       f"{rec['feet'].shape[1]} characters (at most 10 drawn), LOD {h.get('lod')}."}
+                                       f"{rec['feet'].shape[1]} characters (at most 10 drawn), LOD {h.get('lod')}; "
+                                       f"the clip shows at most the first {CLIP_MAX_FRAMES} frames."}
             progress("writing", done, total)
             meta = {"format": REPORT_FORMAT, "version": REPORT_VERSION, "footfall": __version__, "preset": preset,
                     "seed": int(seed), "scenarios": list(options.scenarios), "sizes": list(options.sizes),

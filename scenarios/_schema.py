@@ -269,9 +269,86 @@ def _field(loc: tuple[Any, ...], kind: str) -> str:
     return "".join(parts) or "(document)"
 
 
-def input_error(error: ValidationError, file: str) -> InputError:
-    """The :class:`InputError` for the first problem pydantic found in ``file``."""
-    first = error.errors(include_url=False)[0]
+def pydantic_reason(error: dict[str, Any]) -> str:
+    """The REASON of an error line for one pydantic error (``must be >= 1``, ``expected an integer``).
+
+    Also used for the command line's option values, which typer validates with pydantic.
+    """
+    return _reason(error)
+
+
+def _known_keys(model: Any, loc: tuple[Any, ...]) -> list[str] | None:
+    """The keys a table at ``loc`` (a pydantic error location, tags included) may hold, or None.
+
+    Walks the models down ``loc``: through optional values, lists (an index in ``loc``) and
+    tagged unions (the tag in ``loc``, as pydantic reports it).
+    """
+    import types
+    import typing
+
+    annotation: Any = model
+    items = list(loc)
+    while True:
+        origin = typing.get_origin(annotation)
+        if origin is Annotated:
+            annotation = typing.get_args(annotation)[0]
+            continue
+        if origin in (Union, types.UnionType):
+            options = [a for a in typing.get_args(annotation) if a is not type(None)]
+            tagged = {}
+            for a in options:
+                base = typing.get_args(a)[0] if typing.get_origin(a) is Annotated else a
+                kind = getattr(base, "model_fields", {}).get("kind")
+                if kind is not None and typing.get_origin(kind.annotation) is Literal:
+                    tagged[typing.get_args(kind.annotation)[0]] = a
+            if tagged and items and items[0] in tagged:
+                annotation = tagged[items.pop(0)]
+                continue
+            if len(options) != 1:
+                return None
+            annotation = options[0]
+            continue
+        if origin is list:
+            if not items or not isinstance(items[0], int):
+                return None
+            items.pop(0)
+            annotation = typing.get_args(annotation)[0]
+            continue
+        fields = getattr(annotation, "model_fields", None)
+        if fields is None:
+            return None
+        if not items:
+            return list(fields)
+        name = items.pop(0)
+        if name not in fields:
+            return None
+        annotation = fields[name].annotation
+
+
+def _unknown_key_error(model: Any, error: dict[str, Any], file: str) -> InputError:
+    """``FILE: terain: unknown section; did you mean terrain?`` for a key the model does not have."""
+    import difflib
+
+    loc = tuple(error["loc"])
+    name = str(loc[-1])
+    what = "unknown section" if isinstance(error.get("input"), dict) else "unknown key"
+    known = _known_keys(model, loc[:-1]) or []
+    close = difflib.get_close_matches(name, known, n=1, cutoff=0.6)
+    hint = f"; did you mean {close[0]}?" if close else (f"; expected one of {', '.join(known)}" if known else "")
+    return InputError(file, _field(loc, error["type"]), what + hint)
+
+
+def input_error(error: ValidationError, file: str, model: Any = None) -> InputError:
+    """The :class:`InputError` for the first problem pydantic found in ``file``.
+
+    An unknown key comes first: a misspelt section (``[terain]``) also makes the section it
+    meant missing, and the misspelling is the problem to name.
+    """
+    errors = error.errors(include_url=False)
+    unknown = [e for e in errors if e["type"] == "extra_forbidden"]
+    if unknown and model is not None:
+        return _unknown_key_error(model, unknown[0], file)
+    first = (unknown or errors)[0]
     return InputError(file, _field(tuple(first["loc"]), first["type"]), _reason(first))
 
 
@@ -280,4 +357,4 @@ def validate(model: type[_Model], data: dict[str, Any], file: str) -> Any:
     try:
         return model.model_validate(data)
     except ValidationError as error:
-        raise input_error(error, file) from None
+        raise input_error(error, file, model) from None

@@ -62,3 +62,114 @@ def test_bench_planner_json_keys():
         assert set(row) == {"first_valid_us", "default_us", "exhaustive_us"}
         assert all(v > 0 for v in row.values())
     assert out["speedup_vs_per_target"] > 0 and out["speedup_vs_skimage_mcp"] > 0
+
+
+# ----------------------------------------------------------------------------- every bad option value: one line
+
+TERAIN = "name = 'x'\n[terain]\nkind = 'flat'\nsize = [5.0, 5.0]\ncell_size = 0.05\n[crowd]\ncreature = 'spider'\n" \
+         "goal = [1.0, 0.0]\n"
+"""A scenario whose [terrain] section is misspelt."""
+
+BAD_INPUTS = [
+    # (arguments, a piece of the one error line)
+    (["simulate", "--frames", "-5"], "argument: --frames: must be >= 1, got -5"),
+    (["simulate", "--frames", "abc"], "argument: --frames: expected an integer, got abc"),
+    (["simulate", "--frames"], "argument: --frames: requires an argument"),
+    (["simulate", "--characters", "0"], "argument: --characters: must be >= 1"),
+    (["simulate", "--seed", "x"], "argument: --seed: expected an integer"),
+    (["simulate", "--lod", "maybe", "--frames", "1"], "argument: --lod: expected one of on, zoomed, off"),
+    (["simulate", "--record", "out.txt"], "argument: --record: expected a .npz path"),
+    (["simulate", "--bogus"], "argument: --bogus: no such option"),
+    (["simulate", "--jsn"], "did you mean --json?"),
+    (["simulate", "--json=1"], "argument: --json: does not take a value"),
+    (["simulate", "flat", "extra"], "argument: extra: unexpected extra argument"),
+    (["simulate", "no-such-place"], "no-such-place: scenario: unknown scenario"),
+    (["simulate", "--preset", "nosuch"], "argument: --preset:"),
+    (["plan", "flat", "--budget", "lavish"], "argument: --budget: expected one of"),
+    (["plan", "flat", "--step", "-1"], "argument: --step: expected a positive number"),
+    (["evaluate", "--seeds", "0"], "argument: --seeds:"),
+    (["evaluate", "--lod", "sometimes"], "argument: --lod:"),
+    (["run", "--workers", "abc"], "argument: --workers: expected an integer"),
+    (["report", "--quick", "--full"], "argument: --quick/--full:"),
+    (["tune"], "argument: --creature: required"),
+    (["tune", "--creature", "nosuch"], "unknown creature"),
+    (["export-usd"], "argument: --out: required"),
+    (["export-usd", "--out", "scene.txt"], "expected a .usda, .usdc, .usd file name"),
+    (["bench", "crowd", "--frames", "0"], "argument: --frames: must be >= 1"),
+    (["bench", "nosuch"], "argument: nosuch: no such command of footfall bench"),
+    (["simulat"], "argument: simulat: no such command of footfall; did you mean simulate?"),
+    (["check", "{terain}"], "terain: unknown section; did you mean terrain?"),
+]
+
+
+@pytest.mark.parametrize("args, expected", BAD_INPUTS, ids=[" ".join(a) for a, _ in BAD_INPUTS])
+def test_every_bad_input_is_one_line_and_exit_2(tmp_path, args, expected):
+    terain = tmp_path / "terain.toml"
+    terain.write_text(TERAIN)
+    proc = run(*[a.replace("{terain}", str(terain)) for a in args], cwd=tmp_path)
+    assert proc.returncode == 2, proc.stderr
+    assert proc.stdout == ""
+    lines = proc.stderr.splitlines()
+    assert len(lines) == 1, proc.stderr  # no blank line, no box, no usage line, no traceback
+    assert lines[0].startswith("footfall: error: "), lines[0]
+    assert expected in lines[0], lines[0]
+    assert list(tmp_path.iterdir()) == [terain]  # nothing written
+
+
+# ----------------------------------------------------------------------------- help, listing, progress, timing
+
+
+def test_help_shows_flags_as_flags_and_one_line_summaries():
+    proc = run("simulate", "--help")
+    assert proc.returncode == 0
+    assert "--json" in proc.stdout and "<bool>" not in proc.stdout
+    import os
+
+    wide = subprocess.run(CLI + ["--help"], capture_output=True, text=True, timeout=600,
+                          env=dict(os.environ, COLUMNS="200"))
+    listing = wide.stdout[wide.stdout.index("Commands"):].splitlines()[1:-1]
+    # Each command's summary is one line (its docstring's first paragraph): no row continues the one before.
+    continued = [line for line in listing if line.startswith("│" + " " * 6)]
+    assert listing and not continued, wide.stdout
+
+
+def test_scenarios_lists_descriptions_creatures_and_gaits():
+    proc = run("scenarios")
+    assert proc.returncode == 0, proc.stderr
+    out = proc.stdout
+    assert "mixed (default)" in out and "3 x spider" in out and "rolling hills" in out
+    assert "8 legs" in out and "spider-metachronal-wave, then spider-alternating-tetrapod from Fr 0.2" in out
+    assert "quadruped-trot" in out and "Diagonal pairs" in out
+
+
+def test_progress_off_a_terminal_prints_a_line_per_step_and_every_few_seconds():
+    import io
+    import time
+
+    from footfall._progress import Progress
+
+    stream = io.StringIO()
+    with Progress("footfall run", interval=0.2, stream=stream) as bar:
+        assert stream.getvalue() == ""  # nothing before the first update
+        bar.update("[1/2] simulate: 3 x spider", step="simulate")
+        bar.update("[1/2] simulate: more", step="simulate")  # same step, too soon: no line
+        time.sleep(0.5)  # the work reports nothing: the display still says it is alive
+        bar.update("[2/2] tune: round 1", step="tune")
+    lines = stream.getvalue().splitlines()
+    assert lines[0] == "footfall run: [1/2] simulate: 3 x spider (0 s)"
+    assert any(line.startswith("footfall run: [1/2] simulate: more (") for line in lines[1:-1])
+    assert lines[-1].startswith("footfall run: [2/2] tune: round 1 (")
+    assert all(line.endswith(" s)") for line in lines)
+    quiet = io.StringIO()
+    with Progress("footfall run", enabled=False, stream=quiet) as bar:
+        bar.update("x", step="simulate")
+    assert quiet.getvalue() == ""
+
+
+def test_simulate_separates_warmup_from_steady_frames():
+    proc = run("simulate", "flat", "--frames", "4", "--json")
+    assert proc.returncode == 0, proc.stderr
+    out = json.loads(proc.stdout)
+    assert out["ms_per_frame_warmup"] > 0 and out["ms_per_frame_steady"] > 0
+    mean = (out["ms_per_frame_warmup"] + 3 * out["ms_per_frame_steady"]) / 4
+    assert abs(out["ms_per_frame_mean"] - mean) < 1e-6 * max(1.0, mean)

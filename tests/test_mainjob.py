@@ -38,8 +38,15 @@ def test_run_writes_every_output_into_one_folder(tmp_path):
     skeletons = [p for p in stage.Traverse() if p.IsA(UsdSkel.Skeleton)]
     assert len(skeletons) >= 1
     assert summary["export"]["collisions"] == 0 and summary["simulate"]["collisions"] == 0
+    # the clip of the recorded crowd: at least 60 frames at 30 fps
+    import imageio.v2 as imageio
+
+    reader = imageio.get_reader(out / "clip.mp4", format="FFMPEG")
+    frames = sum(1 for _ in reader)
+    reader.close()
+    assert frames >= 60 and summary["outputs"]["clip"] == str(out / "clip.mp4")
     names = {p.name for p in out.iterdir()}
-    assert {"preset.json", "recording.npz", "report", "scene.usdc", "summary.json"} <= names
+    assert {"preset.json", "recording.npz", "report", "scene.usdc", "summary.json", "clip.mp4"} <= names
     assert not [n for n in names if n.startswith(".")], names  # no temporary file left behind
 
 

@@ -137,6 +137,69 @@ def test_report_pictures_are_not_blank(quick):
         assert std > 8.0 and colours > 16 and dark < 0.5, (p.name, std, colours, dark)
 
 
+def test_index_leads_with_a_short_table_and_keeps_the_full_one_behind_a_toggle(quick):
+    out, summary = quick
+    page = (out / "index.html").read_text(encoding="utf-8")
+    quality = page[page.index("<h2>Quality vs cost</h2>"):page.index("<h2>Stride length vs speed</h2>")]
+    tables = re.findall(r"<table>.*?</table>", quality, flags=re.S)
+    assert len(tables) == 2
+    short, full = (re.findall(r'<th title="[^"]*">(.*?)</th>', t) for t in tables)
+    assert len(short) <= 10 and len(full) > len(short)
+    assert short[:3] == ["setting", "cost (x first valid)", "loss %"]
+    assert quality.index("<details>") < quality.index(tables[1])  # the full table only behind the toggle
+    assert len(re.findall(r"<tr class", tables[0])) == len(summary["rows"])
+    # Every scene plot says what its marks mean.
+    for name in ("gait_disks_", "footprints_"):
+        caption = re.search(rf'src="{name}[^"]*"[^>]*><figcaption>(.*?)</figcaption>', page)
+        assert caption and len(caption.group(1)) > 200, name
+
+
+# ----------------------------------------------------------------------------- the footprint and gait plots
+
+
+def _heatmap(scores, chosen_end):
+    """A Fig. 13 situation of a 3 x 3 candidate block on flat ground, the chosen trajectory ending at ``chosen_end``."""
+    cell = 0.07
+    xs, zs = np.meshgrid(np.arange(3) * cell, np.arange(3) * cell)
+    cells = np.column_stack([xs.ravel(), zs.ravel()]) + 0.5
+    chosen = np.array([[0.45, 0.0, 0.45], [chosen_end[0], 0.02, chosen_end[1]]])
+    return {"cell_size": cell, "cells_xz": cells, "scores": np.asarray(scores, np.float64), "chosen": chosen,
+            "others": [chosen + [0.0, 0.0, 0.05]], "source": np.array([0.45, 0.0, 0.45]),
+            "preferred": np.array([0.55, 0.55]), "forbidden_xz": np.array([[0.5, 0.75]]),
+            "elevation": np.zeros((40, 40)), "origin": np.array([-0.5, -0.5]), "couple_score": 0.9}
+
+
+def test_footprint_plot_marks_the_chosen_cell_and_fits_its_colours_to_the_candidates(tmp_path):
+    from reports import _plots
+
+    scores = np.linspace(0.78, 0.93, 9)
+    h = _heatmap(scores, chosen_end=(0.5 + 0.07 + 0.01, 0.5 + 0.14 - 0.02))
+    assert _plots.chosen_cell(h) == 7  # the cell the trajectory ends in, (x 1, z 2) of the block
+    assert _plots.chosen_cell(_heatmap(scores, chosen_end=(2.0, 2.0))) is None  # off every candidate: no mark
+    assert _plots.score_range(scores) == (0.78, 0.93)  # the colours span the candidates, not 0-1
+    lo, hi = _plots.score_range([0.9, 0.9])
+    assert lo < 0.9 < hi
+    path = tmp_path / "footprints.png"
+    _plots.footprint_heatmap({"heatmap": h}, path)
+    std, colours, _ = _image_stats(path)
+    assert std > 8.0 and colours > 16
+
+
+def test_gait_disk_states_name_feet_off_their_schedule(tmp_path):
+    from reports import _plots
+
+    # Needle at 0.3: sectors [0.2, 0.5) and [0.6, 0.9); each foot on the ground or in the air.
+    scene = {"gait_needle": 0.3, "gait_start": np.array([0.2, 0.6, 0.2, 0.6]),
+             "gait_duration": np.array([0.3, 0.3, 0.3, 0.3]), "gait_in_stance": np.array([False, True, True, False]),
+             "leg_names": ["A", "B", "C", "D"], "creature": "test", "gait_name": "test-gait"}
+    assert _plots.gait_disk_states(scene) == ["swing", "stance", "hold", "forced"]
+    scene["gait_start"] = np.array([0.9, 0.9, 0.9, 0.9])  # a sector across 12 o'clock: [0.9, 1.2)
+    assert _plots.gait_disk_states(scene)[:2] == ["forced", "stance"]
+    _plots.gait_disks(scene, tmp_path / "disks.png")
+    std, colours, _ = _image_stats(tmp_path / "disks.png")
+    assert std > 8.0 and colours > 16
+
+
 # ----------------------------------------------------------------------------- renders and the page
 
 
@@ -201,6 +264,32 @@ def test_every_image_loads_in_headless_chromium(quick, tmp_path):
     result = json.loads(found.group(1).replace("&quot;", '"'))
     assert result["images"] == expected
     assert result["broken"] == []
+
+
+def test_the_reports_clips_play_in_headless_chromium(quick, tmp_path):
+    # The real report page (not a page made for the test): every <video> loads, lasts at least 60 frames
+    # (2 s at 30 fps) and shows a picture in its middle; every image is not blank.
+    from test_report_browser import CHECK_SCRIPT as MEDIA_SCRIPT
+    from test_report_browser import CHROMIUM, media_check
+
+    if CHROMIUM is None:
+        pytest.skip("Debian chromium is not installed (.ci/run installs it)")
+    out, summary = quick
+    page = (out / "index.html").read_text(encoding="utf-8")
+    clips = len(re.findall(r"<video ", page))
+    assert clips == len([s for s in summary["scenes"] if s.get("clip")]) >= 1  # one per swept scenario
+    (out / "media-check.html").write_text(page.replace("</body>", MEDIA_SCRIPT + "</body>"), encoding="utf-8")
+    try:
+        media = media_check(out / "media-check.html", tmp_path)
+    finally:
+        (out / "media-check.html").unlink()
+    assert len(media["videos"]) == clips
+    for video in media["videos"]:
+        assert "error" not in video, video
+        assert video["duration"] >= 60 / 30.0 - 0.05, video
+        assert video["frame_spread"] > 8.0, video
+    for image in media["images"]:
+        assert image["loaded"] and image["spread"] > 8.0, image
 
 
 # ----------------------------------------------------------------------------- bad input
