@@ -52,6 +52,8 @@ TRANSITION_RATE = 0.5
 ESCAPE_FROUDE = 0.5
 """The Froude number of a creature's top speed (issue 13: every creature walks up to Fr 0.5)."""
 """Cycles of phase per second a disk moves during a gait change with speed (a new gait within a stride)."""
+STANCE_SLACK_FRAMES = 1.0
+"""Frames of the body's travel kept free at each end of a stance window (planner._workspace.stance_centres)."""
 STAGES = ("steer", "gait", "swing", "requests", "maps", "plan", "pelvis", "ik")
 
 
@@ -392,9 +394,16 @@ def stance_speed_cap(model: CrowdModel, state: CrowdState) -> np.ndarray:
 
 def leg_speed_caps(model: CrowdModel, state: CrowdState) -> np.ndarray:
     """(C, L) the fastest the body may move for each stance foot (inf for swinging feet)."""
+    from planner._timing import stride_frequency
+
     room = stance_room(model, state)
     g = state.gaits
-    frequency = np.maximum(state.stride_frequency, 1e-9)[:, None]
+    # A body standing has no tempo (0 Hz): its feet lift when it walks again, at the tempo of the walk
+    # it resumes. Counting them a cycle of 0 Hz away made every stance foot 'hold the body' (cap 0):
+    # forced steps of the feet just landed, again and again, while the feet at the rear end of their
+    # windows never got their turn (a spider stood on a hill for good with four feet in the air).
+    resume = stride_frequency(model.timing, np.minimum(state.desired_speed, state.speed_limit), model.leg_height)
+    frequency = np.maximum(np.where(state.stride_frequency > 0.0, state.stride_frequency, resume), 1e-9)[:, None]
     until_lift = np.mod(g.disk_start - g.needle[:, None], 1.0) / frequency + model.dt  # lifts the frame its sector starts
     # A foot whose sector has started but which has not lifted yet (its plan is pending) lifts as
     # soon as it can: its next turn is not a cycle away.
@@ -709,7 +718,8 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     # a rear foot half a sweep ahead of its window, in front of the body, across the other legs.
     window = model.stance_window[ls]
     sweep = np.minimum(sweep, window[:, 1] - window[:, 0])
-    centre = stance_centres(spacing * model.rest_body[ls, 0], window, sweep)
+    centre = stance_centres(spacing * model.rest_body[ls, 0], window, sweep,
+                            min_slack=STANCE_SLACK_FRAMES * model.dt * np.maximum(v, goal))
     hx, hz = _rot_xz(heading, model.hips_body[ls, 0], model.hips_body[ls, 2])
     hip_pred = pred + np.stack([hx, hz], axis=1)
     # On a slope the ground under a foot is not where it is on flat: a foot at its horizontal rest

@@ -133,9 +133,10 @@ def _stance_windows(creature, rest_body, hips_body, legs) -> np.ndarray:
     return windows
 
 
-def stance_centres(rest_forward: np.ndarray, windows: np.ndarray, sweep: np.ndarray) -> np.ndarray:
-    """Body-forward centre of each stance sweep: ``clip(rest, lo + s/2 + q, hi - s/2 - q)``,
-    ``q = CENTRE_SLACK * (hi - lo - s)``.
+def stance_centres(rest_forward: np.ndarray, windows: np.ndarray, sweep: np.ndarray, min_slack=0.0) -> np.ndarray:
+    """Body-forward centre of each stance sweep: ``clip(rest, lo + s/2 + r, hi - s/2 - q)``,
+    ``q = CENTRE_SLACK * (hi - lo - s)`` at the front end, ``r = max(q, min(min_slack, (hi - lo - s) / 2))``
+    at the rear end (where the body runs out of a foot that lifts late).
 
     A sweep longer than its window is centred on the window.
 
@@ -147,10 +148,14 @@ def stance_centres(rest_forward: np.ndarray, windows: np.ndarray, sweep: np.ndar
     >>> stance_centres(np.array([-0.28]), np.array([[-0.3, 0.3]]), np.array([0.1]))  # -0.3 + 0.05 + 0.05
     array([-0.2])
     """
-    # Keep a tenth of the free room at each end when the window allows it: a stance can last
-    # longer than planned (a gait change moving the foot's sector, a late landing).
-    slack = CENTRE_SLACK * np.maximum(windows[..., 1] - windows[..., 0] - sweep, 0.0)
-    lo = windows[..., 0] + 0.5 * sweep + slack
+    # Keep a tenth of the free room at each end when the window allows it, and at the rear end at
+    # least ``min_slack`` (a distance the body covers in a frame or two): a stance can last longer
+    # than planned (a gait change moving the foot's sector, a late landing, the lift-off frame). At
+    # speed a tenth of a little free room is less than a frame's travel, and every late frame capped
+    # the body's speed (robot5 at Fr 0.5 kept 0.89 of its asked speed).
+    free = np.maximum(windows[..., 1] - windows[..., 0] - sweep, 0.0)
+    slack = CENTRE_SLACK * free
+    lo = windows[..., 0] + 0.5 * sweep + np.maximum(slack, np.minimum(min_slack, 0.5 * free))
     hi = windows[..., 1] - 0.5 * sweep - slack
     centre = np.minimum(np.maximum(rest_forward, lo), hi)
     return np.where(lo <= hi, centre, 0.5 * (windows[..., 0] + windows[..., 1]))
