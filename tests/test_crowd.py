@@ -32,10 +32,6 @@ def _raster(scenario, creature):
 # a body pose its stance legs cannot follow is taken back.) Strict: when they are fixed, these runs must pass.
 KNOWN_DEFECTS = {
     ("quadruped", "hills"): "rendered leg crossings on hills (the knees fold across)",
-    # The same defect: a swinging front leg's free azimuth (upright legs, planner._ik.legs_of) flips
-    # to about pi on an IK restart and its knee swings across the other front leg (mixed, seed 2,
-    # frame 36, LF azimuth 2.95 rad). Seen once the continuous strides changed the swing timing.
-    ("quadruped", "mixed"): "rendered leg crossings of swinging front legs (free azimuth flips on restart)",
 }
 
 
