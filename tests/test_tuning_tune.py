@@ -220,6 +220,34 @@ def test_a_tune_that_accepts_no_candidate_keeps_the_defaults(tmp_path, monkeypat
     assert [t["decision"] for t in losses["rounds"][0]["line_search"]] == ["refused (test)"] * len(tune_module.LINE_SEARCH)
 
 
+
+def test_a_tuned_preset_that_walks_worse_on_the_held_out_runs_is_not_shipped(tmp_path, monkeypatch):
+    """Every step accepted on the training runs, but the held-out runs (a stand-in for the exact planner
+    there) find the tuned parameters' stride error higher than the defaults': the defaults ship, with the
+    refused round named in the summary."""
+    import tuning._tune as tune_module
+    from planner import GaitTiming, ScoringWeights
+
+    real = tune_module.exact_metrics
+    config = _tiny(rounds=1)
+    held_out = config.holdout_setup()
+
+    def exact_metrics(setup, weights=None, timing=None, **kwargs):
+        m = real(setup, weights, timing, **kwargs)
+        if setup == held_out and weights != ScoringWeights():
+            m = dict(m, stride_rel_error=m["stride_rel_error"] + 0.5)
+        return m
+
+    monkeypatch.setattr(tune_module, "_accept", lambda *args, **kwargs: (True, "improved"))
+    monkeypatch.setattr(tune_module, "exact_metrics", exact_metrics)
+    result = tune_module.tune(config, tmp_path / "refused.json", workers=1)
+    preset = load_preset(tmp_path / "refused.json", "spider")
+    assert result.summary["best_round"] == -1 and "round 0 refused on the held-out runs" in result.summary["heldout_refused"]
+    assert preset.weights == ScoringWeights() and preset.timing == GaitTiming()
+    losses = preset.provenance["losses"]
+    assert losses["heldout_tuned"] == losses["heldout_default"]
+
+
 def _metrics(run_losses, exact_loss):
     return {"finite": True, "collisions": 0, "curvature_energy_mean": 0.0, "curvature_energy_se": 0.0,
             "jerk_median": 1.0, "exact_loss": exact_loss, "stride_rel_error": 0.01,

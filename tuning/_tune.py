@@ -28,6 +28,12 @@ Each outer round r (``rounds`` at most):
    ``TuneConfig.guards`` false (``footfall bench tuning``) a lower exact loss alone is enough.
    The loop stops at the first round that does not improve (or after ``rounds``).
 
+Then the held-out runs (other scenarios and seeds) measure the best parameters against the
+defaults. A tuned preset whose held-out stride error is higher than the defaults' is not
+shipped: the defaults are (``best_round`` -1), and ``heldout_refused`` in the summary says
+which round was refused and why (a fit that beat the defaults on its training terrain but
+walks worse elsewhere is the overfit a preset must not be).
+
 After every round a checkpoint (JSON, written atomically) holds the configuration,
 the round, the current and best parameters (float64 written with ``repr``: exact
 round trip), every exact result and the seeds: :func:`tune` with ``resume=True``
@@ -305,6 +311,8 @@ def _pad_problem(problem, n: int, k: int, s: int):
         cand_features=jnp.asarray(pad(sit.cand_features, 0.0, [(0, n), (1, k)])),
         couple_mask=jnp.asarray(couple_mask),
         couple_raw=jnp.asarray(pad(sit.couple_raw, 0.0, [(0, n), (1, k), (2, s)])),
+        # 1: a padded candidate's straight distance (footprint 0, source 0, at least the padded cell of 1 m)
+        d_ref=jnp.asarray(pad(sit.d_ref, 1.0, [(0, n), (1, k)])),
         source=jnp.asarray(pad(sit.source, 0.0, rows)), preferred=jnp.asarray(pad(sit.preferred, 0.0, rows)),
         forward=jnp.asarray(forward), speed=jnp.asarray(pad(sit.speed, 0.0, rows)),
         leg_height=jnp.asarray(pad(sit.leg_height, 1.0, rows)),
@@ -629,6 +637,14 @@ def _tune(config: TuneConfig, out, resume, progress, stop_after, write, evaluate
             default_exact = exact_metrics(setup, *_objects(_default_params()), targets=targets, map_tasks=map_tasks)
         held_default = exact_metrics(holdout, *_objects(_default_params()), targets=targets, map_tasks=map_tasks)
     held_tuned = exact_metrics(holdout, *_objects(best["params"]), targets=targets, map_tasks=map_tasks)
+    refused = None
+    if best["round"] >= 0 and not config.start_timing and held_tuned["stride_rel_error"] > held_default["stride_rel_error"]:
+        # A preset earns its place on runs it was not fitted to: one that beat the defaults on the training
+        # runs but walks worse on the held-out terrain is not shipped; the defaults are (and say why).
+        refused = (f"round {best['round']} refused on the held-out runs: stride error {held_tuned['stride_rel_error']:.4g} "
+                   f"> the defaults' {held_default['stride_rel_error']:.4g}")
+        best = {"params": _start_params(config), "exact": default_exact, "round": -1}
+        held_tuned = held_default
     rho, n_couples = spearman_proxy_exact(config, best["params"], map_tasks)
     weights, timing = _objects(best["params"])
     from footfall import __version__
@@ -649,6 +665,7 @@ def _tune(config: TuneConfig, out, resume, progress, stop_after, write, evaluate
         "collisions_tuned": best["exact"]["collisions"] + held_tuned["collisions"],
         "spearman_proxy_exact": rho, "spearman_couples": n_couples,
         "rounds_run": state["round"], "best_round": best["round"],
+        "heldout_refused": refused,
     }
     if config.start_timing:
         summary.update({
