@@ -72,6 +72,19 @@ def _run(model, state, frames, each_frame):
     return counters
 
 
+def _run_feet_in_crate(model, state, frames):
+    """Run ``frames`` frames; (rendered foot-frames inside the crate where it is, the run's counters)."""
+    inside = []
+
+    def check(s):
+        c, h, y = _crate_now(model, s.t)
+        feet = np.where(s.ik_on[0], s.fk_feet[0], s.feet[0])
+        inside.append(int(_inside(feet[:, [0, 2]], c, h, y).sum()))
+
+    counters = _run(model, state, frames, check)
+    return sum(inside), counters
+
+
 def test_a_crate_driven_across_a_stance_foot_makes_it_step_away_before_contact(tmp_path):
     # A spider stands at its goal (0, 0), facing +x; its left feet rest about 0.3 m to its
     # left. A 0.16 m crate slides along z = 0.32 at 0.2 m/s from x = -1.5: it sweeps through
@@ -81,15 +94,8 @@ def test_a_crate_driven_across_a_stance_foot_makes_it_step_away_before_contact(t
     left = state.feet[0, :, 2] > 0.2
     centre, half, yaw = _crate_now(model, 7.5)
     assert _inside(state.feet[0][left][:, [0, 2]], centre, half, yaw).any(), "the crate must sweep a foot's spot"
-    inside = []
-
-    def check(s):
-        c, h, y = _crate_now(model, s.t)
-        feet = np.where(s.ik_on[0], s.fk_feet[0], s.feet[0])
-        inside.append(int(_inside(feet[:, [0, 2]], c, h, y).sum()))
-
-    counters = _run(model, state, 450, check)
-    assert sum(inside) == 0
+    inside, counters = _run_feet_in_crate(model, state, 450)
+    assert inside == 0
     assert counters.collisions == 0
     assert state.counters["steps"] > 0
     assert counters.max_stance_slip_m <= 1e-3
@@ -139,17 +145,10 @@ def _crate_from_behind(tmp_path, name, speed, width):
     model, state = _world(tmp_path, name, crate_centre=(-3.6, 0.0), crate_width=width, start=(-2.0, 0.0),
                           goal=(4.0, 0.0), velocity=(speed, 0.0))
     assert speed < model.top_speed
-    inside = []
-
-    def check(s):
-        c, h, y = _crate_now(model, s.t)
-        feet = np.where(s.ik_on[0], s.fk_feet[0], s.feet[0])
-        inside.append(int(_inside(feet[:, [0, 2]], c, h, y).sum()))
-
-    counters = _run(model, state, 450, check)
+    inside, counters = _run_feet_in_crate(model, state, 450)
     crate_x = _crate_now(model, state.t)[0][0]
     assert crate_x > state.pelvis[0, 0], "the crate must catch up with the spider and pass it"
-    return sum(inside), counters
+    return inside, counters
 
 
 def test_a_crate_catching_up_from_behind_passes_without_touching_a_foot(tmp_path):
