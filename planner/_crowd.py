@@ -53,7 +53,7 @@ ESCAPE_FROUDE = 0.5
 """The Froude number of a creature's top speed (issue 13: every creature walks up to Fr 0.5)."""
 """Cycles of phase per second a disk moves during a gait change with speed (a new gait within a stride)."""
 STANCE_SLACK_FRAMES = 1.0
-"""Frames of the body's travel kept free at each end of a stance window (planner._workspace.stance_centres)."""
+"""Frames of the body's travel kept free at the rear end of a stance window (planner._workspace.stance_centres)."""
 STAGES = ("steer", "gait", "swing", "requests", "maps", "plan", "pelvis", "ik")
 
 
@@ -392,17 +392,23 @@ def stance_speed_cap(model: CrowdModel, state: CrowdState) -> np.ndarray:
     return leg_speed_caps(model, state).min(axis=1)
 
 
-def leg_speed_caps(model: CrowdModel, state: CrowdState) -> np.ndarray:
-    """(C, L) the fastest the body may move for each stance foot (inf for swinging feet)."""
+def resume_frequency(model: CrowdModel, state: CrowdState) -> np.ndarray:
+    """(C,) Hz: the stride frequency of the walk each character heads for (its goal speed, within its
+    speed limit): the tempo of a body that stands, or speeds up, once it walks."""
     from planner._timing import stride_frequency
 
+    return stride_frequency(model.timing, np.minimum(state.desired_speed, state.speed_limit), model.leg_height)
+
+
+def leg_speed_caps(model: CrowdModel, state: CrowdState) -> np.ndarray:
+    """(C, L) the fastest the body may move for each stance foot (inf for swinging feet)."""
     room = stance_room(model, state)
     g = state.gaits
     # A body standing has no tempo (0 Hz): its feet lift when it walks again, at the tempo of the walk
     # it resumes. Counting them a cycle of 0 Hz away made every stance foot 'hold the body' (cap 0):
     # forced steps of the feet just landed, again and again, while the feet at the rear end of their
     # windows never got their turn (a spider stood on a hill for good with four feet in the air).
-    resume = stride_frequency(model.timing, np.minimum(state.desired_speed, state.speed_limit), model.leg_height)
+    resume = resume_frequency(model, state)
     frequency = np.maximum(np.where(state.stride_frequency > 0.0, state.stride_frequency, resume), 1e-9)[:, None]
     until_lift = np.mod(g.disk_start - g.needle[:, None], 1.0) / frequency + model.dt  # lifts the frame its sector starts
     # A foot whose sector has started but which has not lifted yet (its plan is pending) lifts as
@@ -674,10 +680,7 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     n_legs = model.n_legs
     map_of = np.full(state.pelvis.shape[0], -1, np.int64)
     map_of[chars] = np.arange(chars.size)
-    from planner._timing import stride_frequency
-
-    resume = stride_frequency(model.timing, np.minimum(state.desired_speed[cs], state.speed_limit[cs]),
-                              model.leg_height)
+    resume = resume_frequency(model, state)[cs]
     # The needle's tempo sets when the foot lifts again (the stance); a body standing (a hold, the
     # first frame) has none yet and takes the tempo of the walk it will resume.
     freq = frequency[cs]
