@@ -393,6 +393,7 @@ step and the elapsed time.
         f"  report    {sec['report']:6.1f} s  {o['report']}  (recommended budget: "
         f"{summary['report']['recommended_budget']})",
         f"  export    {sec['export']:6.1f} s  {o['usd']}",
+        f"  clip      {o['clip'] or 'not rendered: ' + str(summary['clip'].get('error'))}",
         f"  summary   {o['summary']}",
         f"Open {o['report']} in a browser to look at the results.",
     ]
