@@ -344,7 +344,7 @@ def _avoid(model: CrowdModel, state: CrowdState, preferred: np.ndarray, to_targe
 
     n = state.pelvis.shape[0]
     xz = np.ascontiguousarray(state.pelvis[:, [0, 2]])
-    radius = AVOID_RADIUS * model.rest_radius
+    radius = AVOID_RADIUS * crowd_radius(model.creature, model.rest_radius)
     top = model.top_speed if math.isfinite(model.top_speed) else float(np.max(state.desired_speed))
     start, index = neighbour_lists(xz, 2.0 * radius + 2.0 * top * AVOID_HORIZON, AVOID_NEIGHBOURS)
     near = np.zeros(n, np.bool_)
@@ -474,7 +474,7 @@ def arrival_speed(distance, arrive_radius: float, acceleration: float):
 
     Examples
     --------
-    >>> float(arrival_speed(2.3, 0.3, 1.0))   # 2 m to brake in at 1 m/s^2
+    >>> float(arrival_speed(2.5, 0.5, 1.0))   # 2 m to brake in at 1 m/s^2
     2.0
     >>> float(arrival_speed(0.2, 0.3, 1.0))
     0.0
@@ -869,16 +869,34 @@ def _take_back_unfollowed_poses(model: CrowdModel, state: CrowdState, on_screen:
 
 
 # ----------------------------------------------------------------------------- set-up
+def crowd_radius(creature, rest_radius: float | None = None) -> float:
+    """m: the radius a character takes in a crowd: its rest radius (``rest_radius``, the creature's by
+    default), or more for a body box that reaches beyond :data:`AVOID_RADIUS` of it (a quadruped's
+    0.6 m body: the avoidance disc covers the body, and spawns 1.5 such radii apart cannot overlap).
+
+    Examples
+    --------
+    >>> from scenarios import load_creature
+    >>> spider, dog = load_creature("spider"), load_creature("quadruped")
+    >>> crowd_radius(spider) == float(spider.rest_radius)
+    True
+    >>> round(AVOID_RADIUS * crowd_radius(dog), 3) == round(0.5 * float(np.hypot(*dog.body_box)), 3)
+    True
+    """
+    rest = float(creature.rest_radius) if rest_radius is None else float(rest_radius)
+    return max(rest, 0.5 * float(np.hypot(*creature.body_box)) / AVOID_RADIUS)
+
+
 def spawn_positions(scenario, creature, n: int, spacing_factor: float = 1.5):
     """n start positions (x, z) on a sunflower spiral around the crowd centre, clear of boxes.
 
-    Creatures are ``spacing_factor`` x their rest radius apart; when the world is too
-    small the spacing shrinks (down to one rest radius: legs interleave). Raises
-    ``InputError`` when even that does not fit.
+    Creatures are ``spacing_factor`` x their crowd radius (:func:`crowd_radius`, the rest radius
+    for most) apart; when the world is too small the spacing shrinks (down to one radius: legs
+    interleave). Raises ``InputError`` when even that does not fit.
     """
     from footfall._errors import InputError
 
-    rest = float(creature.rest_radius)
+    rest = crowd_radius(creature)
     obs = scenario.obstacles
     centres, _ = obs.poses_at(0.0)
     box_r = 0.5 * np.hypot(obs.sizes[:, 0], obs.sizes[:, 2]) if len(obs.yaws) else np.zeros(0)
