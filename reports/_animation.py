@@ -211,24 +211,23 @@ def render_stills(scene: dict, out_dir, regions=None, size: tuple[int, int] | No
     return names
 
 
-def recording_clip_scene(recording_path, frames: int | None = None,
-                         max_characters: int | None = MAX_DRAWN_CHARACTERS) -> dict:
-    """The scene of the first ``frames`` frames of a recording (``footfall render --recording F``);
-    an :class:`InputError` for a file that is not a recording of a known scenario and creature."""
-    from reports._recording import load_recording
+def run_scene(run, frames: int | None = None, max_characters: int | None = MAX_DRAWN_CHARACTERS) -> dict:
+    """The scene of the first ``frames`` frames of a loaded recording, its scenario and creature looked
+    up by name (an :class:`InputError` when one is not at hand)."""
     from scenarios import load_creature, load_scenario
 
-    run = load_recording(recording_path)
-    if not run.scenario:
-        raise InputError(run.path, "header.scenario", "missing: the recording does not name its scenario")
     if frames is not None:
         run = run.head(frames)
     return recording_scene(run, load_scenario(run.scenario), load_creature(run.creature), max_characters)
 
 
-def clip_of_recording(recording_path, out, *, frames: int | None = None, camera: str = "follow",
-                      size: tuple[int, int] = DEFAULT_SIZE, max_characters: int | None = MAX_DRAWN_CHARACTERS,
-                      progress=None) -> dict:
-    """The first ``frames`` frames of a recording as a clip (:func:`render_clip`)."""
-    scene = recording_clip_scene(recording_path, frames, max_characters)
-    return render_clip(scene, out, camera=camera, size=size, progress=progress)
+def recording_clip_scene(recording_path, frames: int | None = None,
+                         max_characters: int | None = MAX_DRAWN_CHARACTERS) -> dict:
+    """The scene of the first ``frames`` frames of a recording (``footfall render --recording F``);
+    an :class:`InputError` for a file that is not a recording of a known scenario and creature."""
+    from reports._recording import load_recording
+
+    run = load_recording(recording_path)
+    if not run.scenario:
+        raise InputError(run.path, "header.scenario", "missing: the recording does not name its scenario")
+    return run_scene(run, frames, max_characters)

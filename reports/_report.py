@@ -86,15 +86,11 @@ def render_run(recording, out_dir: Path, *, max_characters: int = 10) -> tuple[l
     report): (PNG names, clip name or None, error or None). The creatures are drawn from the
     recording's IK joints (:mod:`reports._animation`); at most ``max_characters`` of them and the
     first :data:`CLIP_MAX_FRAMES` frames."""
-    from reports._animation import RenderError, recording_scene, render_clip, render_stills
-    from scenarios import load_creature, load_scenario
+    from reports._animation import RenderError, render_clip, render_stills, run_scene
 
     out_dir.mkdir(parents=True, exist_ok=True)
-    if recording.frames > CLIP_MAX_FRAMES:
-        recording = recording.head(CLIP_MAX_FRAMES)
     try:
-        scene = recording_scene(recording, load_scenario(recording.scenario), load_creature(recording.creature),
-                                max_characters)
+        scene = run_scene(recording, min(recording.frames, CLIP_MAX_FRAMES), max_characters)
     except InputError as e:  # e.g. a creature file that is not at hand: the report goes on without pictures
         return [], None, f"cannot draw the run: {e}"
     try:
