@@ -48,6 +48,12 @@ OTHER_LEG = 3  # another leg's projection or another foot
 PAD = 4  # the padding ring around the ROI
 
 MIN_STEP_CELLS = 1e-3
+# A footprint belongs to its own cell, borders included (footprint_point puts it on a border when the
+# preferred footprint lies beyond). The chord that ends at it is checked up to this far before it, so
+# that a cell it meets only at the footprint (the neighbour across the border, or the diagonal ones at
+# a corner) does not refuse the couple; the floor convention of cell_of would put such a footprint in
+# the neighbour, and whether it did depended on how (x - origin) / cell rounds.
+END_PULLBACK_M = 1e-9
 """A candidate footprint closer to the foot than this (cells) is no step (and no path)."""
 MAX_SLICES = 12
 MAX_DENSE = 1024  # samples of one path; a longer path is refused
@@ -137,7 +143,8 @@ def prepare_foot(elevation, ground, forbidden, origin_x, origin_z, cell, offsets
             cc = cols[k] - c0 + 1
             if 1 <= rr < hp - 1 and 1 <= cc < wp - 1:
                 p = rr * wp + cc
-                if code[p] == FREE or code[p] == SIZE_INCREASE:
+                # A size-increase cell stays one: it is no footprint, and it seeds the proximity term.
+                if code[p] == FREE:
                     code[p] = OTHER_LEG
         # The other foot itself: every cell whose centre is within feet_block_radius.
         fx = other_legs[j, 2]
@@ -152,7 +159,7 @@ def prepare_foot(elevation, ground, forbidden, origin_x, origin_z, cell, offsets
                     x, z = cell_centre(fr + dr, fc + dc, origin_x, origin_z, cell)
                     if math.hypot(x - fx, z - fz) <= feet_block_radius:
                         p = rr * wp + cc
-                        if code[p] == FREE or code[p] == SIZE_INCREASE:
+                        if code[p] == FREE:
                             code[p] = OTHER_LEG
     return code, elev_dil, boxh_dil, elev_raw, r0, c0, hp, wp
 
@@ -385,6 +392,14 @@ def slice_maps(code, boxh_dil, level, eps, source_p, hp, wp, cell, pot_range, po
             factor[p] = 1.0
 
 
+@nb.njit(cache=True, inline="always")
+def _pulled_back(ax, az, bx, bz):
+    """End point b moved END_PULLBACK_M toward a (b itself for a point segment)."""
+    d = math.hypot(bx - ax, bz - az)
+    back = END_PULLBACK_M / d if d > 0.0 else 0.0
+    return bx - back * (bx - ax), bz - back * (bz - az)
+
+
 @nb.njit(cache=True)
 def segment_clear(ax, az, bx, bz, passable, source_p, r0, c0, hp, wp, origin_x, origin_z, cell, rows, cols):
     """Line of sight: every cell the segment touches is passable (or the source cell)."""
@@ -436,7 +451,10 @@ def naive_and_kept_points(parent, source_p, target_p, source_x, source_z, target
     while i < count - 1:
         j = count - 1
         while j > i + 1:
-            if segment_clear(naive[i, 0], naive[i, 1], naive[j, 0], naive[j, 1], passable, source_p, r0, c0, hp, wp,
+            ex, ez = naive[j, 0], naive[j, 1]
+            if j == count - 1:  # the chord to the footprint: its own cell's border is its own
+                ex, ez = _pulled_back(naive[i, 0], naive[i, 1], ex, ez)
+            if segment_clear(naive[i, 0], naive[i, 1], ex, ez, passable, source_p, r0, c0, hp, wp,
                              origin_x, origin_z, cell, rows, cols):
                 break
             j -= 1
@@ -568,8 +586,8 @@ def resample_by_arclength(poly, n_poly, k, out):
 
 
 @nb.njit(cache=True)
-def path_2d(kept, passable, dt, elev_dil, source_p, r0, c0, hp, wp, origin_x, origin_z, cell, dense, dense_p, rows,
-            cols):
+def path_2d(kept, passable, dt, elev_dil, source_p, target_p, r0, c0, hp, wp, origin_x, origin_z, cell, dense, dense_p,
+            rows, cols):
     """2D Hermite path through the kept points, verified chord by chord.
 
     Tries Catmull-Rom tangents, then halved, then zero tangents (the refined
@@ -586,18 +604,24 @@ def path_2d(kept, passable, dt, elev_dil, source_p, r0, c0, hp, wp, origin_x, or
             continue
         ok = True
         for i in range(n):
-            r, c = cell_of(dense[i, 0], dense[i, 1], origin_x, origin_z, cell)
-            rr = r - r0 + 1
-            cc = c - c0 + 1
-            if rr < 1 or rr >= hp - 1 or cc < 1 or cc >= wp - 1:
-                ok = False
-                break
-            dense_p[i] = rr * wp + cc
+            if i == n - 1:
+                dense_p[i] = target_p  # the footprint is in its own cell (END_PULLBACK_M)
+            else:
+                r, c = cell_of(dense[i, 0], dense[i, 1], origin_x, origin_z, cell)
+                rr = r - r0 + 1
+                cc = c - c0 + 1
+                if rr < 1 or rr >= hp - 1 or cc < 1 or cc >= wp - 1:
+                    ok = False
+                    break
+                dense_p[i] = rr * wp + cc
             if i > 0:
                 if math.hypot(dense[i, 0] - dense[i - 1, 0], dense[i, 1] - dense[i - 1, 1]) > chord_max:
                     ok = False
                     break
-                if not segment_clear(dense[i - 1, 0], dense[i - 1, 1], dense[i, 0], dense[i, 1], passable, source_p,
+                ex, ez = dense[i, 0], dense[i, 1]
+                if i == n - 1:
+                    ex, ez = _pulled_back(dense[i - 1, 0], dense[i - 1, 1], ex, ez)
+                if not segment_clear(dense[i - 1, 0], dense[i - 1, 1], ex, ez, passable, source_p,
                                      r0, c0, hp, wp, origin_x, origin_z, cell, rows, cols):
                     ok = False
                     break
@@ -749,8 +773,8 @@ def couple_metrics_2d(parent, passable, dt, elev_dil, source_p, target_p, source
     passable[target_p] = 1
     kept = naive_and_kept_points(parent, source_p, target_p, source_x, source_z, target_x, target_z, passable, r0, c0,
                                  hp, wp, origin_x, origin_z, cell, rows, cols)
-    nd, len2, curv, clear = path_2d(kept, passable, dt, elev_dil, source_p, r0, c0, hp, wp, origin_x, origin_z, cell,
-                                    dense, dense_p, rows, cols)
+    nd, len2, curv, clear = path_2d(kept, passable, dt, elev_dil, source_p, target_p, r0, c0, hp, wp, origin_x, origin_z,
+                                    cell, dense, dense_p, rows, cols)
     passable[target_p] = was
     if nd < 2:
         return nd, 0.0, 0.0, 0.0, 0.0

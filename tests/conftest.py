@@ -6,6 +6,11 @@ import time
 
 import pytest
 
+# pytest-xdist runs one worker per core: a numba thread pool per worker on top would oversubscribe the
+# cores (parallel kernels spin at their barriers). Set before any test module imports numba.
+if os.environ.get("PYTEST_XDIST_WORKER"):
+    os.environ.setdefault("NUMBA_NUM_THREADS", "1")
+
 
 @pytest.fixture
 def kill_a_busy_worker():
@@ -37,7 +42,9 @@ def kill_a_busy_worker():
 # Property tests run their fixed seeds (every seed that ever failed joins its test's fixed list)
 # plus fresh ones drawn for this session, so that passing means generalising. The session's draw is
 # printed in the header; FOOTFALL_TEST_SEED=<n> replays it. Failure messages name the seed.
-_SESSION_SEED = int(os.environ.get("FOOTFALL_TEST_SEED", str(int.from_bytes(os.urandom(4), "little"))))
+# Drawn once, by the first process that imports this file: pytest-xdist's workers inherit it through
+# the environment, so that every worker collects the same parametrised seeds.
+_SESSION_SEED = int(os.environ.setdefault("FOOTFALL_TEST_SEED", str(int.from_bytes(os.urandom(4), "little"))))
 
 
 def pytest_report_header(config):

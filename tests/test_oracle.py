@@ -24,12 +24,11 @@ The exhaustive search must pick the oracle's best couple (same cell, same point,
 same score to ``SCORE_TOL``); couples tied with it are named and any of them is accepted. Every
 couple of the runtime's harvest must score as the oracle says, too.
 
-Two disagreements were found; the runtime is wrong in both (worked out in the strict xfail tests
-below), and the random comparisons follow it on exactly these two points (``RUNTIME_KNOWN_DEFECTS``):
-a footprint on the border of its cell is refused when the neighbour across is blocked and
-``(x - origin) / cell`` rounds into it; a size-increase cell under another leg becomes an other-leg
-cell, which hides it from the obstacle-proximity term and lets a foot land on it, on the box. Fix the
-runtime, and the strict xfails fail: then drop ``RUNTIME_KNOWN_DEFECTS``.
+Two disagreements were found, and the runtime was wrong in both (the worked-out scenes at the end of
+part (a)): a footprint on the border of its cell was refused when the neighbour across was blocked and
+``(x - origin) / cell`` rounded into it; a size-increase cell under another leg became an other-leg
+cell, which hid it from the obstacle-proximity term and let a foot land on it, on the box. The oracle
+keeps the old conventions as options (``endpoint="floor"``, ``leg_over_size_increase=True``).
 
 (b) each score term on a 5 x 5 grid against numbers worked out by hand (``test_hand_*``): the runtime's
 own functions for the term (``harvest_foot``; the goodness and jerk kernels) against literal numbers.
@@ -583,8 +582,6 @@ N = 14  # cells per side: with the default radius (4 cells) and margin (6 cells)
 CELL = 0.07  # interest is the whole map when the preferred footprint's cell is in rows/cols 3..10.
 FIXED_SEEDS = tuple(range(40))
 N_FRESH = 10
-# The runtime's two known defects (the strict xfails below), followed by the random comparisons.
-RUNTIME_KNOWN_DEFECTS = dict(endpoint="floor", leg_over_size_increase=True)
 
 
 def random_case(rng):
@@ -719,7 +716,7 @@ def _search_and_oracle(seed):
     maps, query, weights = draw_case(seed)
     config = PlannerConfig()
     assert roi_is_the_map(maps, query, config), f"seed {seed}: the case is larger than the search's region"
-    oracle = Oracle(maps, query, weights, config, EXHAUSTIVE.slice_size_m, **RUNTIME_KNOWN_DEFECTS)
+    oracle = Oracle(maps, query, weights, config, EXHAUSTIVE.slice_size_m)
     result = plan_foot(maps, query, weights=weights, budget=EXHAUSTIVE, config=config)
     return maps, query, weights, oracle, oracle.couples(), result
 
@@ -798,7 +795,7 @@ def test_every_couple_scores_as_the_oracle_says(seed):
                 f"{where}: the runtime scores {score:.12f}, the oracle {_describe(couple)}"
 
 
-# ---------------------------------------------------------------------------- disagreements (xfail)
+# ---------------------------------------------------------------------------- disagreements (fixed)
 
 
 def _wall_scene(ox=0.0, mirror=False):
@@ -841,19 +838,17 @@ def _oracle_best(maps, query, **kw):
     return max(oracle.couples(), key=lambda c: min(-math.inf if v is None else v["score"] for v in c[2]))
 
 
-BORDER_REASON = (
-    "A footprint on the high border of its cell (x or z = centre + half a cell, where footprint_point puts it "
-    "when the preferred footprint lies beyond) is floored by cell_of into the neighbour cell; when that "
-    "neighbour is blocked (size increase, another leg, above the slice) the last chord's supercover ends "
-    "in it and segment_clear refuses the couple, although a foot centred anywhere in its own (closed) cell "
-    "is safe. Whether a low-border footprint is refused depends on how (x - origin) / cell rounds.")
-LEG_OVER_RING_REASON = (
-    "prepare_foot turns a size-increase cell under another leg's projection (or within a foot's room of "
-    "another foot) into OTHER_LEG; footprint_candidates then accepts it as the preferred footprint's cell "
-    "and leaves it out of the obstacle-proximity seeds (FORBIDDEN and SIZE_INCREASE codes only).")
+# Scenes where the runtime disagreed with the oracle (both fixed):
+# * A footprint on the high border of its cell (x or z = centre + half a cell, where footprint_point puts it
+#   when the preferred footprint lies beyond) was floored by cell_of into the neighbour cell; when that
+#   neighbour was blocked (size increase, another leg, above the slice) the last chord's supercover ended in
+#   it and segment_clear refused the couple, although a foot anywhere in its own (closed) cell is safe.
+#   Whether a low-border footprint was refused depended on how (x - origin) / cell rounds.
+# * prepare_foot turned a size-increase cell under another leg's projection (or within a foot's room of
+#   another foot) into OTHER_LEG; footprint_candidates then accepted it as the preferred footprint's cell
+#   and left it out of the obstacle-proximity seeds.
 
 
-@pytest.mark.xfail(strict=True, reason=BORDER_REASON)
 def test_a_footprint_on_its_cells_border_next_to_a_wall_is_reached():
     # Cell (7, 8) spans x in [0.56, 0.63]; the preferred footprint x = 0.721 lies beyond it, so its
     # footprint is (0.63, 0.525): the foot (3 x 2 cm) then spans x in [0.615, 0.645], 5.5 cm short of the
@@ -867,7 +862,6 @@ def test_a_footprint_on_its_cells_border_next_to_a_wall_is_reached():
     assert result.target_cell == cand["cell"] and abs(result.couple_score - variants[0]["score"]) <= SCORE_TOL
 
 
-@pytest.mark.xfail(strict=True, reason=BORDER_REASON)
 def test_moving_the_world_by_a_metre_moves_the_footprint_by_a_metre():
     # The mirror image of the wall scene: the border footprint is now on the low side, x = centre - half a
     # cell. At origin 0 the runtime refuses it (0.35 / 0.07 floors to 4, a size-increase cell) and picks
@@ -880,26 +874,27 @@ def test_moving_the_world_by_a_metre_moves_the_footprint_by_a_metre():
     assert picks[0] == picks[1]
 
 
-@pytest.mark.xfail(strict=True, reason=LEG_OVER_RING_REASON + " A foot lands on the box.")
 def test_a_leg_over_a_boxs_ring_does_not_let_the_foot_onto_the_box():
     # The preferred footprint (0.625, 0.51) lies in the size-increase cell (7, 8): a foot there
     # (x in [0.61, 0.64], z in [0.50, 0.52]) overlaps the forbidden cell (7, 9) by 1 cm in x. Without
-    # other legs the search lands at (7, 6), x = 0.49. Another leg, hip (0.585, 0.55) -> foot (0.70, 0.85),
-    # crosses cell (7, 8); it stays 3.9 cm from the preferred footprint (more than a foot's room,
-    # hypot(0.03, 0.02) = 3.6 cm) and does not cross this leg. With it the runtime puts the foot in (7, 8),
-    # on the box.
+    # other legs the search lands on the border of (7, 7) nearest P, (0.56, 0.51): the foot spans x in
+    # [0.545, 0.575], 5.5 cm short of the box. Another leg, hip (0.585, 0.55) -> foot (0.70, 0.85), crosses
+    # cell (7, 8); it stays 3.9 cm from the preferred footprint (more than a foot's room, hypot(0.03, 0.02)
+    # = 3.6 cm) and does not cross this leg. The old runtime then put the foot in (7, 8), on the box.
     legs = [(0.585, 0.55, 0.70, 0.85)]
     maps, query = _box_scene((0.625, 0.51), legs)
     without_leg = plan_foot(maps, dataclasses.replace(query, other_legs=np.zeros((0, 4))), budget=EXHAUSTIVE)
-    assert without_leg.target_cell == (7, 6)
+    assert without_leg.target_cell == (7, 7)
+    assert (without_leg.target[0], without_leg.target[2]) == pytest.approx((0.56, 0.51), abs=1e-12)
     result = plan_foot(maps, query, budget=EXHAUSTIVE)
     x, z = result.target[0], result.target[2]
     assert x + 0.015 <= 0.63 or abs(z - 0.525) >= 0.035 + 0.01, f"the foot at {(x, z)} overlaps the box's cell"
-    # The oracle's pick (with the runtime's border convention, so as to see this defect alone).
-    assert result.target_cell == _oracle_best(maps, query, endpoint="floor")[0]["cell"]
+    assert result.target_cell == _oracle_best(maps, query)[0]["cell"]
+    # The old runtime's conventions (the border footprint floored into its neighbour, a size-increase cell
+    # under a leg turned into another leg's) land on the box.
+    assert _oracle_best(maps, query, endpoint="floor", leg_over_size_increase=True)[0]["cell"] == (7, 8)
 
 
-@pytest.mark.xfail(strict=True, reason=LEG_OVER_RING_REASON + " The box looks a cell farther away.")
 def test_a_leg_over_a_boxs_ring_does_not_hide_the_box():
     # The foot prefers the centre of (7, 7) = (0.525, 0.525). Another leg lies along x = 0.60 (column 8),
     # over the ring's column 8, 7.5 cm from the preferred footprint.
@@ -911,10 +906,12 @@ def test_a_leg_over_a_boxs_ring_does_not_hide_the_box():
     # Cell (7, 7) is one cell from the ring cell (7, 8): distance 0.07 m, goodness 0.07 / 0.10 = 0.7,
     # with the leg or without. The runtime measures 0.14 m (to the box itself), goodness 1.0.
     assert h.cand_features[k, 4] == pytest.approx(0.07, abs=METRIC_TOL)
-    # So the foot moves from (7, 6) (the pick without the leg, and the oracle's with it) to (7, 7), next to
-    # the ring.
-    cand, _, _ = _oracle_best(maps, query, endpoint="floor")
-    assert result.target_cell == cand["cell"] == without_leg.target_cell == (7, 6)
+    # P itself stays the pick, with the leg or without, as the oracle's.
+    cand, _, _ = _oracle_best(maps, query)
+    assert result.target_cell == cand["cell"] == without_leg.target_cell == (7, 7)
+    # The old convention hides the ring under the leg: the oracle then measures 0.14 m too.
+    old = Oracle(maps, query, ScoringWeights(), PlannerConfig(), EXHAUSTIVE.slice_size_m, leg_over_size_increase=True)
+    assert [c["features"][4] for c in old.candidates if c["cell"] == (7, 7)] == [pytest.approx(0.14, abs=METRIC_TOL)]
 
 
 # ============================================================================ (b) each term by hand, 5 x 5 cells
