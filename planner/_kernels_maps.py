@@ -87,7 +87,7 @@ def _stamp_rect(forb, ox, oz, cell, cx, cz, hx, hz, yaw):
 @nb.njit(cache=True, parallel=True)
 def stamp_other_characters(out_forb, out_origin, cell, neighbour_start, neighbour_index, pelvis_xz, headings,
                            body_half_length, body_half_width, feet_xz, in_stance, foot_half):
-    """Flag, in map k, the projected bodies and the stance feet of the characters listed in
+    """Flag, in map k, the projected bodies and the feet (those with ``in_stance``) of the characters listed in
     ``neighbour_index[neighbour_start[k]:neighbour_start[k + 1]]`` as forbidden (issue 14: a foot
     never lands on another's foot or inside another's body; swing paths go around them)."""
     for k in nb.prange(out_forb.shape[0]):

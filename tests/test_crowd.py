@@ -276,3 +276,33 @@ def test_crowds_spawn_as_far_apart_as_promised(scenario_name):
             d = np.hypot(pts[:, None, 0] - pts[None, :, 0], pts[:, None, 1] - pts[None, :, 1])
             d[np.arange(n), np.arange(n)] = np.inf
             assert d.min() >= 1.5 * creature.rest_radius - 1e-9, (scenario_name, creature_name, n, d.min())
+
+
+def test_other_characters_feet_and_landing_spots_are_forbidden_in_a_characters_map():
+    """With ``others_in_maps``, character 0's map forbids the cells under character 1's stance feet and
+    under the spot a swinging foot of character 1 will land on, and nothing of its own feet."""
+    import dataclasses
+
+    from planner._crowd import stage_maps
+
+    scenario, creature = load_scenario("flat"), load_creature("spider")
+    model, state = init_crowd(scenario, creature, load_gait(default_gait_name("spider"), creature), n_characters=2,
+                              seed=0, lod_mode="off", raster=_raster(scenario, creature))
+    cell = model.config.cell_size
+
+    def forbidden_at(points, others_in_maps):
+        m = dataclasses.replace(model, controller=dataclasses.replace(model.controller, others_in_maps=others_in_maps))
+        _, _, forb, origin = stage_maps(m, state, np.array([0]), _no_boxes())
+        rows = np.floor((points[:, 2] - origin[0, 1]) / cell).astype(int)
+        cols = np.floor((points[:, 0] - origin[0, 0]) / cell).astype(int)
+        assert ((rows >= 0) & (rows < forb.shape[1]) & (cols >= 0) & (cols < forb.shape[2])).all()
+        return forb[0, rows, cols].astype(bool)
+
+    # Character 1's foot 0 swings to a spot 0.2 m beside where it stands (a free spot of character 0's map).
+    target = state.feet[1, 0] + np.array([0.0, 0.0, 0.2])
+    state.in_stance[1, 0] = False
+    state.swing_target[1, 0] = target
+    stance = state.feet[1, 1:]
+    assert not forbidden_at(np.vstack([stance, target[None]]), False).any()
+    assert forbidden_at(np.vstack([stance, target[None]]), True).all()
+    assert not forbidden_at(state.feet[0], True).any()
