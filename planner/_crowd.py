@@ -90,7 +90,7 @@ class ControllerConfig:
     step_height_factor: float = 0.3  # x standing height
     reach_margin: float = 0.95  # stance feet beyond this fraction of the reach step
     threat_margin: float = 0.04  # m, a moving box this close to a stance foot makes it step
-    threat_horizon: float = 0.3  # s, ... or this close to it where the box will be this much later
+    threat_horizon: float = 0.5  # s, ... or this close to it where the box will be this much later
     bob_factor: float = 0.03  # x standing height, pelvis bobbing amplitude
     lookahead_frames: int = 4  # stance feet the IK cannot follow this many frames ahead step now
     lookahead_every: int = 2  # frames between two look-ahead checks of a character (< lookahead_frames)
@@ -105,6 +105,8 @@ class ControllerConfig:
     # characters, 300 frames) it takes shared foot spots 408 -> 4 but runs over the per-stride error bar
     # 20 -> 34 (crowded feet step around each other's stamps).
     others_in_maps: bool = False
+    # Other characters' feet near a planned footprint keep a foot's room (stage_plan, _with_neighbours_feet).
+    avoid_others_feet: bool = True
 
     def __post_init__(self) -> None:
         if not 0.0 < self.hold_backoff <= 1.0:
@@ -509,6 +511,56 @@ def _reach_xz(model: CrowdModel) -> np.ndarray:
     return np.sqrt(np.maximum(reach**2 - dy**2, (0.2 * reach) ** 2))
 
 
+def _same_frame_conflicts(model: CrowdModel, cs, targets, valid) -> np.ndarray:
+    """(F,) bool: valid plans whose target lies within a foot's room of an earlier valid plan's target
+    of another character (this frame's plans)."""
+    conflict = np.zeros(cs.size, dtype=np.bool_)
+    if not model.controller.avoid_others_feet or np.unique(cs[valid]).size < 2:
+        return conflict
+    from scipy.spatial import cKDTree
+
+    idx = np.flatnonzero(valid)
+    radius = math.hypot(model.creature.foot_length, model.creature.foot_width)
+    pairs = cKDTree(targets[idx][:, [0, 2]]).query_pairs(radius, output_type="ndarray")
+    if pairs.size:
+        a, b = idx[pairs[:, 0]], idx[pairs[:, 1]]
+        other = cs[a] != cs[b]
+        conflict[np.maximum(a, b)[other]] = True
+    return conflict
+
+
+def _with_neighbours_feet(model: CrowdModel, state: CrowdState, cs, own, preferred):
+    """(legs (M, 4), legs_start (F + 1,)): each planned foot's other legs (``own``, hip -> foot
+    segments of its character) followed by the feet of other characters near its preferred footprint,
+    as zero-length legs (x, z, x, z): where they stand, or, swinging, where they will land.
+
+    The search keeps a foot's room (``block_radius``) from every foot in the list, so a foot never lands
+    on another character's foot (``shared_foot_spots``); a neighbour's foot also lowers the leg-spacing
+    goodness like a foot of the character's own. Stamping whole cells around them in the maps (the
+    ``others_in_maps`` option) blocked 20-30 cm around every foot and broke strides in crowds."""
+    f, k = own.shape[0], own.shape[1]
+    n_chars, n_legs = state.in_stance.shape
+    if not model.controller.avoid_others_feet or n_chars < 2 or f == 0:
+        return np.ascontiguousarray(own.reshape(-1, 4)), np.arange(f + 1, dtype=np.int64) * k
+    from scipy.spatial import cKDTree
+
+    support = np.where(state.in_stance[..., None], state.feet, state.swing_target)[..., [0, 2]].reshape(-1, 2)
+    owner = np.repeat(np.arange(n_chars), n_legs)
+    radius = model.config.search_radius_m + 2.0 * math.hypot(model.creature.foot_length, model.creature.foot_width)
+    found = cKDTree(support).query_ball_point(preferred, radius)
+    near = [np.array(sorted(j for j in hits if owner[j] != c), dtype=np.int64) for c, hits in zip(cs, found)]
+    counts = k + np.array([x.size for x in near], dtype=np.int64)
+    legs_start = np.zeros(f + 1, dtype=np.int64)
+    np.cumsum(counts, out=legs_start[1:])
+    legs = np.empty((legs_start[-1], 4))
+    for i in range(f):
+        a = legs_start[i]
+        legs[a:a + k] = own[i]
+        p = support[near[i]]
+        legs[a + k:legs_start[i + 1]] = np.column_stack([p, p])
+    return legs, legs_start
+
+
 def _solve_feet(model: CrowdModel, state: CrowdState, cs, ls, hips, iterations: int, restarts: int):
     """CCD for legs (cs, ls) reaching for their feet from ``hips``, warm-started from the
     current angles (the one IK call of the controller's look-ahead and IK stages)."""
@@ -758,7 +810,8 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     hz = hips[cs[:, None], oj, 2] + shift[:, None, 1]
     later = np.stack([hx, hz, support[cs[:, None], oj, 0], support[cs[:, None], oj, 2]], axis=-1)
     now = np.stack([hx, hz, state.feet[cs[:, None], oj, 0], state.feet[cs[:, None], oj, 2]], axis=-1)
-    legs = np.concatenate([later, now], axis=1).reshape(-1, 4)
+    own = np.concatenate([later, now], axis=1)  # (F, 2 (L - 1), 4)
+    legs, legs_start = _with_neighbours_feet(model, state, cs, own, preferred)
     couples, slices, _ = budgets
     elev, ground, forb, origin = maps
     batch = FootBatch(
@@ -768,13 +821,16 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
         sources=np.ascontiguousarray(state.feet[cs, ls]), preferred=np.ascontiguousarray(preferred),
         hips=np.ascontiguousarray(hip_pred), reach_xz=_reach_xz(model)[ls],
         step_height=np.full(f, model.step_height),
-        legs=np.ascontiguousarray(legs), legs_start=np.arange(f + 1, dtype=np.int64) * 2 * (n_legs - 1),
+        legs=legs, legs_start=legs_start,
         block_radius=np.full(f, math.hypot(model.creature.foot_length, model.creature.foot_width)),
         couples_after_first=couples[cs], slice_size=slices[cs],
         # the paper's early termination (§5.2) always, unless a fixed budget says otherwise
         early=np.full(f, model.fixed_budget is None or model.fixed_budget.paper_early_stop, np.bool_))
     out = plan_batch(batch, model.weights, model.config, parallel=True)
-    ok = out.valid
+    # Feet of different characters planned in the same frame do not see each other's targets: of two
+    # that would land within a foot's room of each other, the later one (in plan order) waits a frame
+    # and plans again, seeing the other's target.
+    ok = out.valid & ~_same_frame_conflicts(model, cs, out.target, out.valid)
     vc, vl = cs[ok], ls[ok]
     state.trajectories[vc, vl] = out.trajectory[ok]
     state.swing_t[vc, vl] = 0.0
@@ -791,7 +847,7 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
         offset = out.target[fresh][:, [0, 2]] - preferred[fresh]
         np.add.at(state.feedback, cs[fresh], 0.3 * (offset - state.feedback[cs[fresh]]))
     state.counters["plans"] += int(f)
-    state.counters["holds"] += int((~ok & new).sum())
+    state.counters["holds"] += int((~out.valid & new).sum())
     state.counters["replans"] += int((kinds[cs, ls] == 3).sum())
     state.counters["cells_expanded"] += int(out.counters[:, 2].sum())
     state.counters["couples_evaluated"] += int(out.counters[:, 0].sum())

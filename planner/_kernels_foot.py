@@ -236,6 +236,15 @@ def _clear_of_other_feet(x, z, other_legs, leg_gap, feet_block_radius):
 
 
 @nb.njit(cache=True)
+def _near_other_foot(x, z, other_legs, feet_block_radius):
+    """A footprint at (x, z) within ``feet_block_radius`` of another foot (of the character or not)."""
+    for j in range(other_legs.shape[0]):
+        if math.hypot(x - other_legs[j, 2], z - other_legs[j, 3]) <= feet_block_radius:
+            return True
+    return False
+
+
+@nb.njit(cache=True)
 def footprint_point(cx, cz, cell, pref_x, pref_z):
     """The footprint of the cell centred at (cx, cz): the point of its closed square nearest to
     the preferred footprint (so the preferred footprint itself when it lies in the cell). Strides
@@ -299,6 +308,10 @@ def footprint_candidates(code, elev_dil, elev_raw, r0, c0, hp, wp, origin_x, ori
             # opening every such cell doubled the candidates and the planning cost.
             if code[p] == OTHER_LEG and (x != pref_x or z != pref_z or not _clear_of_other_feet(
                     x, z, other_legs, feat[FEAT_LEG_GAP], feet_block_radius)):
+                continue
+            # A free cell next to the cells around another foot: its continuous footprint (on the border
+            # nearest the preferred one) can still be within a foot's room of that foot.
+            if _near_other_foot(x, z, other_legs, feet_block_radius):
                 continue
             footprint_goodness(w, feat, buf)
             cells[m] = p

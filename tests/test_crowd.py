@@ -306,3 +306,20 @@ def test_other_characters_feet_and_landing_spots_are_forbidden_in_a_characters_m
     assert not forbidden_at(np.vstack([stance, target[None]]), False).any()
     assert forbidden_at(np.vstack([stance, target[None]]), True).all()
     assert not forbidden_at(state.feet[0], True).any()
+
+
+def test_a_crowds_feet_keep_a_foots_room_from_each_other():
+    """8 spiders on ``crates``: no two stance feet of different characters closer than a foot length
+    (``shared_foot_spots``), because every planned foot keeps a foot's room from the other characters'
+    feet near it (where they stand, or will land). Without that, the same run shares spots."""
+    import dataclasses
+
+    scenario, creature = load_scenario("crates"), load_creature("spider")
+    counts = {}
+    for avoid in (True, False):
+        model, state = init_crowd(scenario, creature, load_gait(default_gait_name("spider"), creature),
+                                  n_characters=8, seed=5, lod_mode="off", raster=_raster(scenario, creature))
+        model = dataclasses.replace(model, controller=dataclasses.replace(model.controller, avoid_others_feet=avoid))
+        counts[avoid] = simulate(model, state, 200).shared_foot_spots
+    assert counts[True] == 0
+    assert counts[False] > 0, "the run must bring feet of different characters together"

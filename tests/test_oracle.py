@@ -298,6 +298,8 @@ class Oracle:
                     if (tx, tz) != (px, pz) or gap < radius or any(math.hypot(tx - fx, tz - fz) <= radius
                                                                    for _, _, fx, fz in legs):
                         continue
+                if any(math.hypot(tx - fx, tz - fz) <= radius for _, _, fx, fz in legs):
+                    continue  # within a foot's room of another foot (whatever its cell)
                 assert 0 < r < self.n_rows - 1 and 0 < c < self.n_cols - 1, "a footprint on the map's edge"
                 e = self.elev_dil[r, c]
                 rough = max(abs(self.elev[r + dr, c + dc] - e) for dr in (-1, 0, 1) for dc in (-1, 0, 1)
