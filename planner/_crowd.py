@@ -237,6 +237,21 @@ def _boxes_now(model: CrowdModel, t: float):
             np.ascontiguousarray(~np.asarray(obs.is_static), dtype=np.bool_))
 
 
+def _planning_boxes(model: CrowdModel, state: CrowdState, boxes):
+    """The boxes a foot is planned against: every box where it is now, and each moving box also where
+    it will be ``threat_horizon`` from now (about a swing and the first frames of the stance that
+    follows), so that a foot does not land where a crate is heading and is lifted again at once."""
+    centres, sizes, yaws, forbidden, moving = boxes
+    if not moving.any():
+        return boxes
+    later_centres, _, later_yaws, _, _ = _boxes_now(model, state.t + model.controller.threat_horizon)
+    m = np.flatnonzero(moving)
+    return (np.ascontiguousarray(np.vstack([centres, later_centres[m]])), np.ascontiguousarray(np.vstack([sizes, sizes[m]])),
+            np.ascontiguousarray(np.concatenate([yaws, later_yaws[m]])),
+            np.ascontiguousarray(np.concatenate([forbidden, forbidden[m]])),
+            np.ascontiguousarray(np.concatenate([moving, moving[m]])))
+
+
 def _wrap(a):
     return (a + np.pi) % (2.0 * np.pi) - np.pi
 
@@ -1174,7 +1189,7 @@ def step(model: CrowdModel, state: CrowdState) -> dict[str, float]:
     t4 = clock()
     chars = np.unique(np.nonzero(kinds)[0])
     if chars.size:
-        maps = stage_maps(model, state, chars, boxes)
+        maps = stage_maps(model, state, chars, _planning_boxes(model, state, boxes))
         t5 = clock()
         batch, out, cs, ls = stage_plan(model, state, kinds, frequency, budgets, maps, chars, hips)
         state.last_plans = (cs, ls, kinds[cs, ls], out)

@@ -653,7 +653,13 @@ def path_2d(kept, passable, dt, elev_dil, source_p, target_p, r0, c0, hp, wp, or
     clearance = np.inf
     for i in range(1, n - 1):
         u = cum[i] / length if length > 0 else 0.0
-        clearance = min(clearance, dt[dense_p[i]])
+        # Samples in the footprint's own cell when it is blocked (a goal-only cell next to another leg)
+        # or in the source cell when it is (a box moved onto the foot) are at 0 from a blocked cell by
+        # definition: counting them scored every such footprint's path at clearance 0, and a spider's
+        # middle-rear foot landed a cell short of its preferred footprint every other stride.
+        p = dense_p[i]
+        if not ((p == target_p or p == source_p) and dt[p] == 0.0):
+            clearance = min(clearance, dt[p])
         if u < U_LO or u > U_HI:
             continue
         ax = dense[i, 0] - dense[i - 1, 0]
@@ -669,7 +675,7 @@ def path_2d(kept, passable, dt, elev_dil, source_p, target_p, r0, c0, hp, wp, or
         theta = math.atan2(cross, dot)
         ds = 0.5 * (la + lb)
         integral += theta * theta / ds
-    if n <= 2:
+    if clearance == np.inf:
         clearance = dt[dense_p[n - 1]]
     # Highest dilated elevation over the passable cells of the 3 x 3 block of each
     # sample: every point of a chord between two samples lies in a passable cell

@@ -481,8 +481,11 @@ class Oracle:
         chords = np.linalg.norm(np.diff(dense, axis=0), axis=1)
         cum = np.concatenate([[0.0], np.cumsum(chords)])
         length2d = cum[-1]
-        # Clearance: the least distance to a blocked cell over the interior samples.
-        clear = min((sl["clearance"][cells[i]] for i in range(1, n - 1)), default=sl["clearance"][cells[-1]])
+        # Clearance: the least distance to a blocked cell over the interior samples, but for those in the
+        # source's or the footprint's own cell when that cell is blocked (they are at 0 by definition).
+        own = {self.src_rc, cells[-1]}
+        clear = min((sl["clearance"][cells[i]] for i in range(1, n - 1)
+                     if not (cells[i] in own and sl["clearance"][cells[i]] == 0.0)), default=sl["clearance"][cells[-1]])
         # Curvature energy E = L * integral kappa^2 ds, kappa = turning angle / mean adjacent chord.
         integral = 0.0
         for i in range(1, n - 1):
