@@ -16,16 +16,20 @@ Stages of a frame (timed one by one):
 4. ``requests``: feet to plan: new swings; swinging feet to re-plan (turn, speed
    change, trajectory invalidated by a moving box); stance feet out of reach or
    about to be hit by a moving box (they step away).
-5. ``maps``: local maps of the characters that plan this frame (one kernel).
-6. ``plan``: every request in one kernel call (numba prange over the cores), each
-   with its character's LOD budget; a foot with no valid couple holds (stays in
-   stance and asks again next frame).
+5. ``maps``: local maps of the characters that plan this frame (one kernel; with LOD, one
+   more for the far characters' compact maps, ``planner._far_planning``).
+6. ``plan``: every request in one kernel call (numba prange over the cores), each with its
+   character's LOD budget (with LOD, the far characters' requests in calls of their own,
+   ``planner._far_planning``); a foot with no valid couple holds (stays in stance and asks
+   again next frame).
 7. ``pelvis``: height, pitch and roll from convex hulls over the ground and feet.
-8. ``ik``: CCD for every leg of every character that needs it (LOD: not off-screen).
+8. ``ik``: CCD for every leg of every character that needs it (LOD: not off-screen; far
+   characters every ``LodConfig.far_ik_every`` frames, their angles carried forward between).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
@@ -42,7 +46,17 @@ from planner._kernels_controller import (
     swings_invalidated,
 )
 from planner._kernels_maps import build_local_maps
-from planner._lod import FULL_SEARCH, LodConfig, frame_crowd, lod_budgets, visibility
+from planner._lod import (
+    FULL_SEARCH,
+    LEVEL_FAR,
+    LEVEL_FULL,
+    LEVEL_HIDDEN,
+    LodConfig,
+    frame_crowd,
+    lod_budgets,
+    lod_levels,
+    visibility,
+)
 from planner._maps import WorldRaster
 from planner._params import PlannerConfig, SearchBudget
 from planner._weights import ScoringWeights
@@ -143,6 +157,10 @@ class CrowdModel:
     # cap, at most Froude number ESCAPE_FROUDE. A box at least this fast cannot be escaped.
     top_speed: float = math.inf
     height_range: np.ndarray | None = None  # (L, 2) m, least and most pelvis height above each foot (planner._workspace)
+    # The far levels of detail's planner settings (planner._far_planning): the first try and the fallback,
+    # both on compact maps; None with lod_mode 'off' (every character plans as the paper does).
+    far_first: PlannerConfig | None = None
+    far_fallback: PlannerConfig | None = None
 
     @property
     def n_legs(self) -> int:
@@ -195,7 +213,7 @@ class CrowdState:
     gaits: object  # planner._gait.GaitManagerState
     angles: np.ndarray  # (C, L, S + 1)
     residual: np.ndarray  # (C, L)
-    ik_on: np.ndarray  # (C,) bool, IK solved this frame
+    ik_on: np.ndarray  # (C,) bool: drawn from its joint angles this frame (solved, or carried forward by LOD)
     fk_feet: np.ndarray  # (C, L, 3) feet where the IK put them
     hull: np.ndarray  # (C,)
     pelvis_rise: np.ndarray  # (C,) m, change of pelvis height over the last frame
@@ -209,6 +227,16 @@ class CrowdState:
     counters: dict = field(default_factory=dict)
     last_plans: object = None  # (chars, legs, kinds, BatchResult) of the last frame, for recordings
     last_batch: object = None  # the FootBatch planned in the last frame (what the tuning harvest re-scores)
+    # [(FootBatch, PlannerConfig, request rows)] of the last frame, one per map resolution: rows index
+    # last_plans' requests (a single fine group with LOD off, where last_batch is that group's batch).
+    last_groups: list = field(default_factory=list)
+    # Level of detail (planner._lod): each character's level, and the IK carried between two solves of
+    # a far character: the angles and frame of its last solve and their change per frame since the one before.
+    lod_level: np.ndarray | None = None  # (C,) int8, LEVEL_*
+    ik_solved: np.ndarray | None = None  # (C,) bool: the IK solved this character's legs this frame
+    ik_anchor: np.ndarray | None = None  # (C, L, S + 1) angles of the last solve
+    ik_anchor_frame: np.ndarray | None = None  # (C,) int64 frame of the last solve (-1: none)
+    ik_rate: np.ndarray | None = None  # (C, L, S + 1) rad per frame
 
 
 def hips_world(model: CrowdModel, state: CrowdState) -> np.ndarray:
@@ -511,6 +539,7 @@ def _solve_feet(model: CrowdModel, state: CrowdState, cs, ls, hips, iterations: 
     from planner._ik import solve_legs
 
     legs = model.leg_static
+    state.counters["ik_legs_solved"] += int(cs.size)
     # The body poses as (yaw, pitch, roll): rotations built from angles need no orthonormality check.
     pose = np.column_stack([state.heading[cs], state.pitch[cs], state.roll[cs]])
     return solve_legs(hips, pose, legs.rest_azimuths[ls], legs.segment_lengths[ls], legs.limits[ls],
@@ -527,6 +556,11 @@ def _stance_unreachable_ahead(model: CrowdModel, state: CrowdState, hips, freque
     # Each character is checked every ``lookahead_every`` frames (in turns, so the cost is
     # spread); the look-ahead horizon covers the frames in between.
     turn = (np.arange(state.pelvis.shape[0]) + state.frame) % ctl.lookahead_every == 0
+    if model.lod_mode != "off":
+        # A far character (LOD) is looked ahead for as often as its IK is solved, within the horizon.
+        every = min(ctl.lookahead_every * model.lod.far_ik_every, ctl.lookahead_frames)
+        far = state.lod_level == LEVEL_FAR
+        turn = np.where(far, (np.arange(far.size) + state.frame) % every == 0, turn)
     cs, ls = np.nonzero(state.in_stance & (state.ik_on & turn)[:, None])
     if cs.size == 0:
         return out.copy()
@@ -614,7 +648,8 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, fre
 
 
 def character_budgets(model: CrowdModel, state: CrowdState):
-    """(couples_after_first (C,), slice_size (C,), on_screen (C,)) from the LOD mode and camera."""
+    """(couples_after_first (C,), slice_size (C,), on_screen (C,)) from the LOD mode and camera;
+    with a LOD mode, each character's level of detail too (``state.lod_level``, planner._lod)."""
     n = state.pelvis.shape[0]
     if model.lod_mode == "off":
         c, s, _ = (model.fixed_budget or FULL_SEARCH).kernel_args()
@@ -626,13 +661,27 @@ def character_budgets(model: CrowdModel, state: CrowdState):
         camera = frame_crowd(state.pelvis, fov, fraction=0.5, focus=0)
     on_screen, distance = visibility(camera, state.pelvis)
     couples, slices = lod_budgets(on_screen, distance, model.lod)
+    state.lod_level = lod_levels(on_screen, distance, state.lod_level, model.lod)
     return couples, slices, on_screen
 
 
-def stage_maps(model: CrowdModel, state: CrowdState, chars: np.ndarray, boxes):
+def map_groups(model: CrowdModel, state: CrowdState, chars: np.ndarray) -> list[tuple[np.ndarray, bool]]:
+    """The planning characters ``chars`` by how they plan: [(characters, far)], the near group
+    first; one near group of them all with LOD off (the maps and the plan of the paper)."""
+    if model.far_first is None:
+        return [(chars, False)]
+    far = state.lod_level[chars] != LEVEL_FULL
+    return [(g, flag) for g, flag in ((chars[~far], False), (chars[far], True)) if g.size]
+
+
+def stage_maps(model: CrowdModel, state: CrowdState, chars: np.ndarray, boxes, far: bool = False):
+    """Local maps of ``chars`` (the compact ones of far characters with ``far``):
+    (elevation, ground, forbidden, origin)."""
     r = model.raster
-    n = model.config.map_cells
+    config = model.far_fallback if far else model.config
+    n = config.map_cells
     k = chars.size
+    state.counters["map_cells_built"] += k * n * n
     elev = np.empty((k, n, n))
     ground = np.empty((k, n, n))
     forb = np.empty((k, n, n), dtype=np.uint8)
@@ -642,11 +691,11 @@ def stage_maps(model: CrowdModel, state: CrowdState, chars: np.ndarray, boxes):
                      r.frame.cell_size, np.ascontiguousarray(state.pelvis[chars][:, [0, 2]]), centres, sizes, yaws,
                      forbidden, moving, elev, ground, forb, origin)
     if model.controller.others_in_maps:
-        _stamp_others(model, state, chars, forb, origin)
+        _stamp_others(model, state, chars, forb, origin, config)
     return elev, ground, forb, origin
 
 
-def _stamp_others(model: CrowdModel, state: CrowdState, chars: np.ndarray, forb, origin) -> None:
+def _stamp_others(model: CrowdModel, state: CrowdState, chars: np.ndarray, forb, origin, config: PlannerConfig) -> None:
     """Other characters' bodies and stance feet into the planning characters' obstacles' maps."""
     from scipy.spatial import cKDTree
 
@@ -656,7 +705,7 @@ def _stamp_others(model: CrowdModel, state: CrowdState, chars: np.ndarray, forb,
     if n < 2:
         return
     xz = np.ascontiguousarray(state.pelvis[:, [0, 2]])
-    half_map = 0.5 * model.config.map_cells * model.config.cell_size
+    half_map = 0.5 * config.map_cells * config.cell_size
     radius = math.sqrt(2.0) * half_map + model.rest_radius + float(np.max(model.reach))
     lists = cKDTree(xz).query_ball_point(xz[chars], radius)
     counts = np.array([len(x) - 1 for x in lists], dtype=np.int64)
@@ -667,19 +716,19 @@ def _stamp_others(model: CrowdModel, state: CrowdState, chars: np.ndarray, forb,
         others = [j for j in found if j != c]
         index[start[k]:start[k + 1]] = sorted(others)
     box = model.creature.body_box
-    stamp_other_characters(forb, origin, model.config.cell_size, start, index, xz,
+    stamp_other_characters(forb, origin, config.cell_size, start, index, xz,
                            np.ascontiguousarray(state.heading), 0.5 * float(box[0]), 0.5 * float(box[1]),
                            np.ascontiguousarray(state.feet[..., [0, 2]]), np.ascontiguousarray(state.in_stance),
                            0.5 * float(model.creature.foot_length))
 
 
-def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, maps, chars, hips):
-    """Plan every request in one kernel call; apply the results. Returns the batch result."""
+def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, maps, groups, hips):
+    """Plan every request, one kernel call per map resolution (``groups`` and their ``maps``,
+    :func:`map_groups`, :func:`stage_maps`); apply the results. Returns (the fine group's batch or
+    None, the results of every request, the requests' characters, legs)."""
     cs, ls = np.nonzero(kinds)
     f = cs.size
     n_legs = model.n_legs
-    map_of = np.full(state.pelvis.shape[0], -1, np.int64)
-    map_of[chars] = np.arange(chars.size)
     resume = resume_frequency(model, state)[cs]
     # The needle's tempo sets when the foot lifts again (the stance); a body standing (a hold, the
     # first frame) has none yet and takes the tempo of the walk it will resume.
@@ -753,9 +802,8 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     now = np.stack([hx, hz, state.feet[cs[:, None], oj, 0], state.feet[cs[:, None], oj, 2]], axis=-1)
     legs = np.concatenate([later, now], axis=1).reshape(-1, 4)
     couples, slices, _ = budgets
-    elev, ground, forb, origin = maps
-    batch = FootBatch(
-        elevation=elev, ground=ground, forbidden=forb, origins=origin, foot_char=map_of[cs],
+    request = FootBatch(
+        elevation=None, ground=None, forbidden=None, origins=None, foot_char=None,
         foot_shape=np.stack([np.full(f, model.creature.foot_length), np.full(f, model.creature.foot_width), foot_yaw],
                             axis=1),
         sources=np.ascontiguousarray(state.feet[cs, ls]), preferred=np.ascontiguousarray(preferred),
@@ -766,7 +814,8 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
         couples_after_first=couples[cs], slice_size=slices[cs],
         # the paper's early termination (§5.2) always, unless a fixed budget says otherwise
         early=np.full(f, model.fixed_budget is None or model.fixed_budget.paper_early_stop, np.bool_))
-    out = plan_batch(batch, model.weights, model.config, parallel=True)
+    out, state.last_groups = _plan_groups(model, state, request, cs, maps, groups)
+    batch = state.last_groups[0][0] if len(state.last_groups) == 1 and not groups[0][1] else None
     ok = out.valid
     vc, vl = cs[ok], ls[ok]
     state.trajectories[vc, vl] = out.trajectory[ok]
@@ -789,6 +838,72 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     state.counters["cells_expanded"] += int(out.counters[:, 2].sum())
     state.counters["couples_evaluated"] += int(out.counters[:, 0].sum())
     return batch, out, cs, ls
+
+
+def _plan_groups(model: CrowdModel, state: CrowdState, request: FootBatch, cs, maps, groups):
+    """Plan the requests of ``request`` (a FootBatch without maps, one row per request of character
+    ``cs``) with the maps of their character's group; a far group first tries near the preferred
+    footprint, then the full first-valid search for the feet left without a valid couple
+    (planner._far_planning). Returns (the results of every request, [(FootBatch, PlannerConfig,
+    request rows)] per planning call)."""
+    n = state.pelvis.shape[0]
+    done = []
+    for (chars, far), (elev, ground, forb, origin) in zip(groups, maps):
+        map_of = np.full(n, -1, np.int64)
+        map_of[chars] = np.arange(chars.size)
+        if len(groups) == 1:
+            rows = np.arange(cs.size)
+            sub = request
+        else:
+            rows = np.flatnonzero(map_of[cs] >= 0)
+            sub = _take_requests(request, rows)
+        batch = dataclasses.replace(sub, elevation=elev, ground=ground, forbidden=forb, origins=origin,
+                                    foot_char=map_of[cs[rows]])
+        config = model.far_first if far else model.config
+        done.append((batch, config, rows, plan_batch(batch, model.weights, config, parallel=True)))
+        missed = np.flatnonzero(~done[-1][3].valid) if far else np.zeros(0, np.int64)
+        if missed.size:
+            retry = dataclasses.replace(_take_requests(batch, missed), elevation=elev, ground=ground, forbidden=forb,
+                                        origins=origin, foot_char=batch.foot_char[missed])
+            done.append((retry, model.far_fallback, rows[missed],
+                         plan_batch(retry, model.weights, model.far_fallback, parallel=True)))
+    if len(done) == 1:
+        out = done[0][3]
+    else:
+        # A retried foot's result replaces its first try's; the work of both is counted.
+        counters = np.zeros((cs.size,) + done[0][3].counters.shape[1:], np.int64)
+        for _, _, rows, result in done:
+            counters[rows] += result.counters
+        out = _merge_results([(rows, result) for _, _, rows, result in done], cs.size)
+        out.counters[:] = counters
+    return out, [(batch, config, rows) for batch, config, rows, _ in done]
+
+
+def _take_requests(request: FootBatch, rows: np.ndarray) -> FootBatch:
+    """The requests ``rows`` of ``request`` (maps not set), each keeping its other legs."""
+    starts = request.legs_start
+    counts = starts[rows + 1] - starts[rows]
+    legs_start = np.zeros(rows.size + 1, np.int64)
+    np.cumsum(counts, out=legs_start[1:])
+    leg_rows = np.repeat(starts[rows] - legs_start[:-1], counts) + np.arange(legs_start[-1])
+    per_foot = {name: np.ascontiguousarray(getattr(request, name)[rows])
+                for name in ("foot_shape", "sources", "preferred", "hips", "reach_xz", "step_height", "block_radius",
+                             "couples_after_first", "slice_size", "early")}
+    return dataclasses.replace(request, legs=np.ascontiguousarray(request.legs[leg_rows]), legs_start=legs_start,
+                               **per_foot)
+
+
+def _merge_results(parts, n: int):
+    """One BatchResult of ``n`` requests from [(rows, BatchResult of those rows)]."""
+    from planner._batch import BatchResult
+
+    first = parts[0][1]
+    merged = BatchResult(**{name: np.zeros((n,) + getattr(first, name).shape[1:], getattr(first, name).dtype)
+                            for name in BatchResult.__dataclass_fields__})
+    for rows, result in parts:
+        for name in BatchResult.__dataclass_fields__:
+            getattr(merged, name)[rows] = getattr(result, name)
+    return merged
 
 
 def stage_pelvis(model: CrowdModel, state: CrowdState) -> None:
@@ -814,14 +929,21 @@ def stage_pelvis(model: CrowdModel, state: CrowdState) -> None:
 def stage_ik(model: CrowdModel, state: CrowdState, on_screen: np.ndarray) -> None:
     """CCD for every leg of the characters that need it, warm-started from the previous
     frame: stance legs with restarts (a stance foot must be followed exactly), swinging
-    legs without (they only need to be close, and restarts are what costs)."""
+    legs without (they only need to be close, and restarts are what costs).
+
+    With a LOD mode, a far character (``LEVEL_FAR``) is solved every ``far_ik_every`` frames
+    (in turns, so the cost is spread) and, between, its joint angles go on changing at the rate
+    of its last two solves (:func:`_carry_ik`): a stance leg's angles change smoothly while the
+    body walks, so the carried pose stays within a fraction of a millimetre of its foot."""
     state.ik_on[:] = False
+    solve, carried = _ik_turns(model, state, on_screen)
+    state.ik_solved = solve
     if not on_screen.any():
         return
     hips = hips_world(model, state)
     ctl = model.controller
     for stance, restarts, iterations in ((True, ctl.ik_restarts, ctl.ik_iterations), (False, ctl.ik_restarts, ctl.ik_swing_iterations)):
-        cs, ls = np.nonzero(on_screen[:, None] & (state.in_stance == stance))
+        cs, ls = np.nonzero(solve[:, None] & (state.in_stance == stance))
         if cs.size == 0:
             continue
         res = _solve_feet(model, state, cs, ls, hips[cs, ls], iterations, restarts)
@@ -829,7 +951,64 @@ def stage_ik(model: CrowdModel, state: CrowdState, on_screen: np.ndarray) -> Non
         state.residual[cs, ls] = res.residual
         state.fk_feet[cs, ls] = res.feet
     state.ik_on[on_screen] = True
-    _take_back_unfollowed_poses(model, state, on_screen)
+    if carried.any():
+        _carry_ik(model, state, carried, hips)
+    # Only a solved pose says whether a stance leg can follow (a carried one is a guess).
+    _take_back_unfollowed_poses(model, state, solve)
+    if model.lod_mode != "off":
+        _anchor_ik(model, state, solve)
+
+
+def _ik_turns(model: CrowdModel, state: CrowdState, on_screen: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(solve (C,), carried (C,)): the characters whose legs the IK solves this frame, and the far
+    ones whose angles are carried forward instead (LOD, :func:`stage_ik`)."""
+    if model.lod_mode == "off":
+        return on_screen, np.zeros_like(on_screen)
+    every = model.lod.far_ik_every
+    turn = (np.arange(on_screen.size) + state.frame) % every == 0
+    # A character without a solve in its last turn (it was off screen, or full) is solved now.
+    recent = state.ik_anchor_frame >= state.frame - every
+    carried = on_screen & (state.lod_level == LEVEL_FAR) & ~turn & recent
+    return on_screen & ~carried, carried
+
+
+def _anchor_ik(model: CrowdModel, state: CrowdState, solved: np.ndarray) -> None:
+    """Remember the solved characters' angles and their change per frame since the last solve
+    (zero when that solve is older than a far character's turn: nothing to go on)."""
+    cs = np.flatnonzero(solved)
+    if cs.size == 0:
+        return
+    gap = state.frame - state.ik_anchor_frame[cs]
+    fresh = (gap >= 1) & (gap <= model.lod.far_ik_every)
+    rate = (state.angles[cs] - state.ik_anchor[cs]) / np.maximum(gap, 1)[:, None, None]
+    state.ik_rate[cs] = np.where(fresh[:, None, None], rate, 0.0)
+    state.ik_anchor[cs] = state.angles[cs]
+    state.ik_anchor_frame[cs] = state.frame
+
+
+def _carry_ik(model: CrowdModel, state: CrowdState, carried: np.ndarray, hips: np.ndarray) -> None:
+    """The carried characters' angles: their last solve plus its rate times the frames since
+    (within the joint limits), and where that puts their feet (forward kinematics)."""
+    from planner._ik import body_rotation
+    from planner._kernels_ik import forward_kinematics_batch
+
+    cs = np.flatnonzero(carried)
+    legs = model.leg_static
+    lo = np.concatenate([-legs.azimuth_limits[:, None], legs.limits[..., 0]], axis=1)  # (L, S + 1)
+    hi = np.concatenate([legs.azimuth_limits[:, None], legs.limits[..., 1]], axis=1)
+    since = (state.frame - state.ik_anchor_frame[cs]).astype(np.float64)
+    angles = np.clip(state.ik_anchor[cs] + state.ik_rate[cs] * since[:, None, None], lo, hi)
+    state.angles[cs] = angles
+    n_legs = model.n_legs
+    b = cs.size * n_legs
+    rotations = np.repeat(body_rotation(state.heading[cs], state.pitch[cs], state.roll[cs]), n_legs, axis=0)
+    joints = np.empty((b, legs.segment_lengths.shape[1] + 2, 3))
+    forward_kinematics_batch(np.ascontiguousarray(hips[cs].reshape(b, 3)), np.ascontiguousarray(rotations),
+                             np.tile(legs.rest_azimuths, cs.size), np.tile(legs.segment_lengths, (cs.size, 1)),
+                             np.ascontiguousarray(angles.reshape(b, -1)), joints)
+    feet = joints[:, -1].reshape(cs.size, n_legs, 3)
+    state.fk_feet[cs] = feet
+    state.residual[cs] = np.linalg.norm(feet - state.feet[cs], axis=-1)
 
 
 def _pose(state: CrowdState) -> np.ndarray:
@@ -1006,13 +1185,19 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
     cap = speed_cap(timing, hip_height(creature), float(np.min(window[:, 1] - window[:, 0])))
     speed = min(speed_asked, cap)
     escape = min(cap, math.sqrt(ESCAPE_FROUDE * GRAVITY * hip_height(creature)))
+    far_first, far_fallback = None, None
+    if lod_mode != "off":
+        from planner._far_planning import far_configs
+
+        far_first, far_fallback = far_configs(config, span, lod.far_radius_cells, lod.far_margin_cells)
     model = CrowdModel(
         creature=creature, gait=schedule.gaits[0], timing=timing, weights=weights, config=config, controller=controller, lod=lod,
         lod_mode=lod_mode, raster=raster, camera=scenario.camera, dt=DT, feet_spacing=spacing,
         hips_body=hips_body, rest_body=rest_body, reach=np.asarray(creature.leg_reach, dtype=np.float64),
         leg_static=leg_static, fixed_budget=budget, schedule=schedule, stance_window=window, speed_cap=cap,
         speed_asked=speed_asked, step_height=step_height, top_speed=max(escape, speed),
-        height_range=height_ranges(creature, rest_body, hips_body, leg_static))
+        height_range=height_ranges(creature, rest_body, hips_body, leg_static), far_first=far_first,
+        far_fallback=far_fallback)
     rng = np.random.default_rng(seed)
     positions = spawn_positions(scenario, creature, n)
     if scenario.crowd.heading_mode == "random":
@@ -1050,7 +1235,9 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         ik_on=np.zeros(n, np.bool_), fk_feet=feet.copy(), hull=np.zeros(n), pelvis_rise=np.zeros(n), body_held=np.zeros(n, np.bool_), speed_limit=np.full(n, np.inf), last_move=np.zeros((n, 2)), cannot_follow=np.zeros((n, L), np.bool_), pose_before=np.zeros((n, 6)),
         gait_index=gait_index, stride_frequency=np.zeros(n),
         counters={k: 0 for k in ("steps", "plans", "holds", "replans", "forbidden_footprints", "cells_expanded",
-                                 "couples_evaluated", "pose_takebacks")})
+                                 "couples_evaluated", "pose_takebacks", "map_cells_built", "ik_legs_solved")},
+        lod_level=np.full(n, LEVEL_FULL, np.int8), ik_solved=np.zeros(n, np.bool_), ik_anchor=angles.copy(),
+        ik_anchor_frame=np.full(n, -1, np.int64), ik_rate=np.zeros_like(angles))
     stage_pelvis(model, state)
     state.pelvis_rise[:] = 0.0
     state.pose_before = _pose(state)  # nothing to take back before the first frame
@@ -1111,15 +1298,17 @@ def step(model: CrowdModel, state: CrowdState) -> dict[str, float]:
     t4 = clock()
     chars = np.unique(np.nonzero(kinds)[0])
     if chars.size:
-        maps = stage_maps(model, state, chars, boxes)
+        groups = map_groups(model, state, chars)
+        maps = [stage_maps(model, state, group, boxes, far) for group, far in groups]
         t5 = clock()
-        batch, out, cs, ls = stage_plan(model, state, kinds, frequency, budgets, maps, chars, hips)
+        batch, out, cs, ls = stage_plan(model, state, kinds, frequency, budgets, maps, groups, hips)
         state.last_plans = (cs, ls, kinds[cs, ls], out)
         state.last_batch = batch
     else:
         t5 = clock()
         state.last_plans = None
         state.last_batch = None
+        state.last_groups = []
     t6 = clock()
     stage_pelvis(model, state)
     t7 = clock()

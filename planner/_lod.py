@@ -1,10 +1,26 @@
-"""Level of detail (paper §6): a camera decides how hard each character searches.
+"""Level of detail (paper §6): a camera decides how hard each character searches and how
+much work its frame costs.
 
 * Off-screen: the first valid couple, no slices, no IK.
 * On-screen: the couples evaluated after the first valid one and the slice size
   are interpolated linearly with the distance to the camera: at ``near_m`` the
   full budget (``max_couples`` couples after the first, ``near_slice_m`` slices),
   at ``far_m`` and beyond the first valid couple and no slices.
+
+The search budget alone saves little: the shared wavefront, the foot-shape dilation and
+the IK cost the same for every budget (issue 15). So each character also gets a *level*
+(:func:`lod_levels`) that removes work:
+
+* ``LEVEL_FULL`` (on screen, nearer than ``far_m``): the paper's 70 x 70 maps of 7 cm, IK
+  every frame.
+* ``LEVEL_FAR`` (on screen, ``far_m`` and beyond): the far planning of
+  :mod:`planner._far_planning` (compact maps, a first try in a small region around the
+  preferred footprint), and the IK solved every ``far_ik_every`` frames, the joint angles
+  carried forward at their last rate in between.
+* ``LEVEL_HIDDEN`` (off screen): the far planning and no IK.
+
+A character moves to a farther level at ``far_m`` and back to a nearer one only
+``hysteresis_m`` closer, so one walking along the boundary does not flip every frame.
 
 Modes of the paper's Table 1: ``on`` (the camera frames the whole crowd),
 ``zoomed`` (the camera follows character 0, zoomed so that about half the crowd
@@ -21,6 +37,8 @@ import numpy as np
 from planner._params import SearchBudget
 
 LOD_MODES = ("on", "zoomed", "off")
+LEVEL_FULL, LEVEL_FAR, LEVEL_HIDDEN = 0, 1, 2
+LEVEL_NAMES = ("full", "far", "hidden")
 
 
 @dataclass(frozen=True)
@@ -32,8 +50,18 @@ class LodConfig:
     max_couples: int = 8
     near_slice_m: float = 0.10
     far_slice_m: float = 0.30  # beyond this interpolated size: no slices
+    far_radius_cells: int = 1  # cells: candidate disc of a far foot's first try (planner._far_planning)
+    far_margin_cells: int = 1  # cells: region-of-interest margin of a far foot's first try
+    far_ik_every: int = 2  # frames between two IK solves of a LEVEL_FAR character
+    hysteresis_m: float = 1.0  # back from LEVEL_FAR to LEVEL_FULL only this much nearer than far_m
 
     def __post_init__(self) -> None:
+        for name, least in (("far_radius_cells", 1), ("far_margin_cells", 0), ("far_ik_every", 1)):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < least:
+                raise ValueError(f"LodConfig.{name}: expected an integer >= {least}, got {v!r}")
+        if not (isinstance(self.hysteresis_m, (int, float)) and 0.0 <= self.hysteresis_m < self.far_m):
+            raise ValueError(f"LodConfig.hysteresis_m: expected a number in [0, far_m), got {self.hysteresis_m!r}")
         if not (0 <= self.near_m < self.far_m):
             raise ValueError(f"LodConfig.near_m/far_m: expected 0 <= near < far, got {self.near_m}, {self.far_m}")
         if self.max_couples < 0:
@@ -101,3 +129,19 @@ def lod_budgets(on_screen: np.ndarray, distance: np.ndarray, config: LodConfig) 
     couples = np.where(on_screen, couples, 0)
     slices = np.where(on_screen, slices, -1.0)
     return couples, slices
+
+
+def lod_levels(on_screen: np.ndarray, distance: np.ndarray, previous: np.ndarray, config: LodConfig) -> np.ndarray:
+    """(C,) int8 level of each character (module doc) from its visibility, its distance to the
+    camera (m) and its ``previous`` level (the hysteresis).
+
+    Examples
+    --------
+    >>> cfg = LodConfig(far_m=12.0, hysteresis_m=1.0)
+    >>> lod_levels(np.array([True, True, True, False]), np.array([5.0, 11.5, 12.0, 5.0]),
+    ...            np.array([0, 1, 0, 0]), cfg).tolist()
+    [0, 1, 1, 2]
+    """
+    far = distance >= np.where(previous == LEVEL_FULL, config.far_m, config.far_m - config.hysteresis_m)
+    level = np.where(far, LEVEL_FAR, LEVEL_FULL)
+    return np.where(on_screen, level, LEVEL_HIDDEN).astype(np.int8)
