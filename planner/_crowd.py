@@ -24,7 +24,7 @@ Stages of a frame (timed one by one):
    again next frame).
 7. ``pelvis``: height, pitch and roll from convex hulls over the ground and feet.
 8. ``ik``: CCD for every leg of every character that needs it (LOD: not off-screen; far
-   characters every ``LodConfig.far_ik_every`` frames, their angles carried forward between).
+   characters: the closed-form two-bone solve).
 """
 
 from __future__ import annotations
@@ -50,7 +50,6 @@ from planner._lod import (
     FULL_SEARCH,
     LEVEL_FAR,
     LEVEL_FULL,
-    LEVEL_HIDDEN,
     LodConfig,
     frame_crowd,
     lod_budgets,
@@ -213,7 +212,7 @@ class CrowdState:
     gaits: object  # planner._gait.GaitManagerState
     angles: np.ndarray  # (C, L, S + 1)
     residual: np.ndarray  # (C, L)
-    ik_on: np.ndarray  # (C,) bool: drawn from its joint angles this frame (solved, or carried forward by LOD)
+    ik_on: np.ndarray  # (C,) bool, IK solved this frame
     fk_feet: np.ndarray  # (C, L, 3) feet where the IK put them
     hull: np.ndarray  # (C,)
     pelvis_rise: np.ndarray  # (C,) m, change of pelvis height over the last frame
@@ -230,13 +229,7 @@ class CrowdState:
     # [(FootBatch, PlannerConfig, request rows)] of the last frame, one per map resolution: rows index
     # last_plans' requests (a single fine group with LOD off, where last_batch is that group's batch).
     last_groups: list = field(default_factory=list)
-    # Level of detail (planner._lod): each character's level, and the IK carried between two solves of
-    # a far character: the angles and frame of its last solve and their change per frame since the one before.
-    lod_level: np.ndarray | None = None  # (C,) int8, LEVEL_*
-    ik_solved: np.ndarray | None = None  # (C,) bool: the IK solved this character's legs this frame
-    ik_anchor: np.ndarray | None = None  # (C, L, S + 1) angles of the last solve
-    ik_anchor_frame: np.ndarray | None = None  # (C,) int64 frame of the last solve (-1: none)
-    ik_rate: np.ndarray | None = None  # (C, L, S + 1) rad per frame
+    lod_level: np.ndarray | None = None  # (C,) int8: each character's level of detail (planner._lod, LEVEL_*)
 
 
 def hips_world(model: CrowdModel, state: CrowdState) -> np.ndarray:
@@ -533,9 +526,11 @@ def _reach_xz(model: CrowdModel) -> np.ndarray:
     return np.sqrt(np.maximum(reach**2 - dy**2, (0.2 * reach) ** 2))
 
 
-def _solve_feet(model: CrowdModel, state: CrowdState, cs, ls, hips, iterations: int, restarts: int):
-    """CCD for legs (cs, ls) reaching for their feet from ``hips``, warm-started from the
-    current angles (the one IK call of the controller's look-ahead and IK stages)."""
+def _solve_feet(model: CrowdModel, state: CrowdState, cs, ls, hips, iterations: int, restarts: int,
+                two_bone: bool = False):
+    """CCD (or, with ``two_bone``, the closed-form solve of far characters) for legs (cs, ls)
+    reaching for their feet from ``hips``, warm-started from the current angles (the one IK call
+    of the controller's look-ahead and IK stages)."""
     from planner._ik import solve_legs
 
     legs = model.leg_static
@@ -544,7 +539,7 @@ def _solve_feet(model: CrowdModel, state: CrowdState, cs, ls, hips, iterations: 
     pose = np.column_stack([state.heading[cs], state.pitch[cs], state.roll[cs]])
     return solve_legs(hips, pose, legs.rest_azimuths[ls], legs.segment_lengths[ls], legs.limits[ls],
                       legs.azimuth_limits[ls], state.feet[cs, ls], warm_start=state.angles[cs, ls],
-                      max_iterations=iterations, restarts=restarts)
+                      max_iterations=iterations, restarts=restarts, two_bone=two_bone)
 
 
 def _stance_unreachable_ahead(model: CrowdModel, state: CrowdState, hips, frequency) -> np.ndarray:
@@ -556,11 +551,6 @@ def _stance_unreachable_ahead(model: CrowdModel, state: CrowdState, hips, freque
     # Each character is checked every ``lookahead_every`` frames (in turns, so the cost is
     # spread); the look-ahead horizon covers the frames in between.
     turn = (np.arange(state.pelvis.shape[0]) + state.frame) % ctl.lookahead_every == 0
-    if model.lod_mode != "off":
-        # A far character (LOD) is looked ahead for as often as its IK is solved, within the horizon.
-        every = min(ctl.lookahead_every * model.lod.far_ik_every, ctl.lookahead_frames)
-        far = state.lod_level == LEVEL_FAR
-        turn = np.where(far, (np.arange(far.size) + state.frame) % every == 0, turn)
     cs, ls = np.nonzero(state.in_stance & (state.ik_on & turn)[:, None])
     if cs.size == 0:
         return out.copy()
@@ -576,8 +566,15 @@ def _stance_unreachable_ahead(model: CrowdModel, state: CrowdState, hips, freque
     # The pelvis keeps rising (or sinking) as it did over the last frame; rising is what
     # stretches a stance leg, so only a rise is carried forward.
     shifted[:, 1] += (horizon / model.dt) * np.maximum(state.pelvis_rise[cs], 0.0)
-    res = _solve_feet(model, state, cs, ls, shifted, iterations=ctl.ik_iterations, restarts=ctl.ik_restarts)
-    out[cs, ls] = res.residual > ctl.ik_slip_margin
+    # A far character (LOD) looks ahead with its own IK, the two-bone solve.
+    two_bone = _two_bone_characters(model, state)[cs]
+    for far in (False, True) if two_bone.any() else (False,):
+        k = np.flatnonzero(two_bone == far)
+        if k.size == 0:
+            continue
+        res = _solve_feet(model, state, cs[k], ls[k], shifted[k], iterations=ctl.ik_iterations,
+                          restarts=ctl.ik_restarts, two_bone=far)
+        out[cs[k], ls[k]] = res.residual > ctl.ik_slip_margin
     return out.copy()
 
 
@@ -931,84 +928,38 @@ def stage_ik(model: CrowdModel, state: CrowdState, on_screen: np.ndarray) -> Non
     frame: stance legs with restarts (a stance foot must be followed exactly), swinging
     legs without (they only need to be close, and restarts are what costs).
 
-    With a LOD mode, a far character (``LEVEL_FAR``) is solved every ``far_ik_every`` frames
-    (in turns, so the cost is spread) and, between, its joint angles go on changing at the rate
-    of its last two solves (:func:`_carry_ik`): a stance leg's angles change smoothly while the
-    body walks, so the carried pose stays within a fraction of a millimetre of its foot."""
+    With a LOD mode, a far character (``LEVEL_FAR``) is solved in closed form instead, from its
+    previous pose: the azimuth and two hinges (``solve_legs(..., two_bone=True)``), exact wherever
+    those reach, a few trigonometric calls per leg instead of a CCD sweep's dozens."""
     state.ik_on[:] = False
-    solve, carried = _ik_turns(model, state, on_screen)
-    state.ik_solved = solve
     if not on_screen.any():
         return
     hips = hips_world(model, state)
     ctl = model.controller
+    far = _two_bone_characters(model, state) & on_screen
     for stance, restarts, iterations in ((True, ctl.ik_restarts, ctl.ik_iterations), (False, ctl.ik_restarts, ctl.ik_swing_iterations)):
-        cs, ls = np.nonzero(solve[:, None] & (state.in_stance == stance))
+        cs, ls = np.nonzero((on_screen & ~far)[:, None] & (state.in_stance == stance))
         if cs.size == 0:
             continue
         res = _solve_feet(model, state, cs, ls, hips[cs, ls], iterations, restarts)
         state.angles[cs, ls] = res.angles
         state.residual[cs, ls] = res.residual
         state.fk_feet[cs, ls] = res.feet
+    if far.any():
+        cs, ls = np.nonzero(np.broadcast_to(far[:, None], state.in_stance.shape))
+        res = _solve_feet(model, state, cs, ls, hips[cs, ls], 1, 0, two_bone=True)
+        state.angles[cs, ls] = res.angles
+        state.residual[cs, ls] = res.residual
+        state.fk_feet[cs, ls] = res.feet
     state.ik_on[on_screen] = True
-    if carried.any():
-        _carry_ik(model, state, carried, hips)
-    # Only a solved pose says whether a stance leg can follow (a carried one is a guess).
-    _take_back_unfollowed_poses(model, state, solve)
-    if model.lod_mode != "off":
-        _anchor_ik(model, state, solve)
+    _take_back_unfollowed_poses(model, state, on_screen)
 
 
-def _ik_turns(model: CrowdModel, state: CrowdState, on_screen: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(solve (C,), carried (C,)): the characters whose legs the IK solves this frame, and the far
-    ones whose angles are carried forward instead (LOD, :func:`stage_ik`)."""
+def _two_bone_characters(model: CrowdModel, state: CrowdState) -> np.ndarray:
+    """(C,) the characters whose IK is the closed-form two-bone solve (LOD: the far ones)."""
     if model.lod_mode == "off":
-        return on_screen, np.zeros_like(on_screen)
-    every = model.lod.far_ik_every
-    turn = (np.arange(on_screen.size) + state.frame) % every == 0
-    # A character without a solve in its last turn (it was off screen, or full) is solved now.
-    recent = state.ik_anchor_frame >= state.frame - every
-    carried = on_screen & (state.lod_level == LEVEL_FAR) & ~turn & recent
-    return on_screen & ~carried, carried
-
-
-def _anchor_ik(model: CrowdModel, state: CrowdState, solved: np.ndarray) -> None:
-    """Remember the solved characters' angles and their change per frame since the last solve
-    (zero when that solve is older than a far character's turn: nothing to go on)."""
-    cs = np.flatnonzero(solved)
-    if cs.size == 0:
-        return
-    gap = state.frame - state.ik_anchor_frame[cs]
-    fresh = (gap >= 1) & (gap <= model.lod.far_ik_every)
-    rate = (state.angles[cs] - state.ik_anchor[cs]) / np.maximum(gap, 1)[:, None, None]
-    state.ik_rate[cs] = np.where(fresh[:, None, None], rate, 0.0)
-    state.ik_anchor[cs] = state.angles[cs]
-    state.ik_anchor_frame[cs] = state.frame
-
-
-def _carry_ik(model: CrowdModel, state: CrowdState, carried: np.ndarray, hips: np.ndarray) -> None:
-    """The carried characters' angles: their last solve plus its rate times the frames since
-    (within the joint limits), and where that puts their feet (forward kinematics)."""
-    from planner._ik import body_rotation
-    from planner._kernels_ik import forward_kinematics_batch
-
-    cs = np.flatnonzero(carried)
-    legs = model.leg_static
-    lo = np.concatenate([-legs.azimuth_limits[:, None], legs.limits[..., 0]], axis=1)  # (L, S + 1)
-    hi = np.concatenate([legs.azimuth_limits[:, None], legs.limits[..., 1]], axis=1)
-    since = (state.frame - state.ik_anchor_frame[cs]).astype(np.float64)
-    angles = np.clip(state.ik_anchor[cs] + state.ik_rate[cs] * since[:, None, None], lo, hi)
-    state.angles[cs] = angles
-    n_legs = model.n_legs
-    b = cs.size * n_legs
-    rotations = np.repeat(body_rotation(state.heading[cs], state.pitch[cs], state.roll[cs]), n_legs, axis=0)
-    joints = np.empty((b, legs.segment_lengths.shape[1] + 2, 3))
-    forward_kinematics_batch(np.ascontiguousarray(hips[cs].reshape(b, 3)), np.ascontiguousarray(rotations),
-                             np.tile(legs.rest_azimuths, cs.size), np.tile(legs.segment_lengths, (cs.size, 1)),
-                             np.ascontiguousarray(angles.reshape(b, -1)), joints)
-    feet = joints[:, -1].reshape(cs.size, n_legs, 3)
-    state.fk_feet[cs] = feet
-    state.residual[cs] = np.linalg.norm(feet - state.feet[cs], axis=-1)
+        return np.zeros(state.pelvis.shape[0], np.bool_)
+    return state.lod_level == LEVEL_FAR
 
 
 def _pose(state: CrowdState) -> np.ndarray:
@@ -1189,7 +1140,8 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
     if lod_mode != "off":
         from planner._far_planning import far_configs
 
-        far_first, far_fallback = far_configs(config, span, lod.far_radius_cells, lod.far_margin_cells)
+        far_first, far_fallback = far_configs(config, span, lod.far_radius_cells, lod.far_margin_cells,
+                                              lod.far_fallback_margin_cells)
     model = CrowdModel(
         creature=creature, gait=schedule.gaits[0], timing=timing, weights=weights, config=config, controller=controller, lod=lod,
         lod_mode=lod_mode, raster=raster, camera=scenario.camera, dt=DT, feet_spacing=spacing,
@@ -1236,8 +1188,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         gait_index=gait_index, stride_frequency=np.zeros(n),
         counters={k: 0 for k in ("steps", "plans", "holds", "replans", "forbidden_footprints", "cells_expanded",
                                  "couples_evaluated", "pose_takebacks", "map_cells_built", "ik_legs_solved")},
-        lod_level=np.full(n, LEVEL_FULL, np.int8), ik_solved=np.zeros(n, np.bool_), ik_anchor=angles.copy(),
-        ik_anchor_frame=np.full(n, -1, np.int64), ik_rate=np.zeros_like(angles))
+        lod_level=np.full(n, LEVEL_FULL, np.int8))
     stage_pelvis(model, state)
     state.pelvis_rise[:] = 0.0
     state.pose_before = _pose(state)  # nothing to take back before the first frame

@@ -15,8 +15,8 @@ the IK cost the same for every budget (issue 15). So each character also gets a 
   every frame.
 * ``LEVEL_FAR`` (on screen, ``far_m`` and beyond): the far planning of
   :mod:`planner._far_planning` (compact maps, a first try in a small region around the
-  preferred footprint), and the IK solved every ``far_ik_every`` frames, the joint angles
-  carried forward at their last rate in between.
+  preferred footprint), and the IK in closed form: the azimuth and two hinges from the last
+  pose (``planner._ik.solve_legs(..., two_bone=True)``), exact wherever they reach.
 * ``LEVEL_HIDDEN`` (off screen): the far planning and no IK.
 
 A character moves to a farther level at ``far_m`` and back to a nearer one only
@@ -52,11 +52,12 @@ class LodConfig:
     far_slice_m: float = 0.30  # beyond this interpolated size: no slices
     far_radius_cells: int = 1  # cells: candidate disc of a far foot's first try (planner._far_planning)
     far_margin_cells: int = 1  # cells: region-of-interest margin of a far foot's first try
-    far_ik_every: int = 2  # frames between two IK solves of a LEVEL_FAR character
+    far_fallback_margin_cells: int = 3  # cells: ... of its full first-valid search (the planner's: 6)
     hysteresis_m: float = 1.0  # back from LEVEL_FAR to LEVEL_FULL only this much nearer than far_m
 
     def __post_init__(self) -> None:
-        for name, least in (("far_radius_cells", 1), ("far_margin_cells", 0), ("far_ik_every", 1)):
+        for name, least in (("far_radius_cells", 1), ("far_margin_cells", 0), ("far_fallback_margin_cells", 0),
+):
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < least:
                 raise ValueError(f"LodConfig.{name}: expected an integer >= {least}, got {v!r}")
