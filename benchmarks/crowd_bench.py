@@ -9,7 +9,8 @@ programs slow every frame down (their milliseconds do not).
 Per mode: the median ms per frame (all stages: 'total for characters') with a 95 % confidence
 interval of that median (order statistics of the frames), the medians of the maps preparation,
 planning and IK stages, the average FPS (1000 / mean frame ms), and the work done per frame
-(plans, local-map cells built, IK legs solved), counted by the runtime. Per size:
+(plans, local-map cells built, legs solved by CCD and by the two-bone IK, wavefront cells
+expanded, couples evaluated), counted by the runtime. Per size:
 ``ratio_on_off``, the LOD-on median over the LOD-off median, with a 95 % bootstrap interval over
 the rounds (``ratio_on_off_ci``).
 
@@ -30,7 +31,7 @@ SIZES = (100, 1000, 3000, 5000)
 SMALL_WORLD_MAX = 1000
 LARGE_SCENARIO = "mixed@terrain.size=[60.0,60.0]"
 BOOTSTRAP = 400  # resamples of the rounds for the ratio's interval
-WORK = ("plans", "map_cells_built", "ik_legs_solved", "cells_expanded", "couples_evaluated")
+WORK = ("plans", "map_cells_built", "ik_ccd_legs", "ik_two_bone_legs", "cells_expanded", "couples_evaluated")
 
 
 def scenario_for(n: int, scenario_name: str = "mixed") -> str:

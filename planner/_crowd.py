@@ -534,7 +534,7 @@ def _solve_feet(model: CrowdModel, state: CrowdState, cs, ls, hips, iterations: 
     from planner._ik import solve_legs
 
     legs = model.leg_static
-    state.counters["ik_legs_solved"] += int(cs.size)
+    state.counters["ik_two_bone_legs" if two_bone else "ik_ccd_legs"] += int(cs.size)
     # The body poses as (yaw, pitch, roll): rotations built from angles need no orthonormality check.
     pose = np.column_stack([state.heading[cs], state.pitch[cs], state.roll[cs]])
     return solve_legs(hips, pose, legs.rest_azimuths[ls], legs.segment_lengths[ls], legs.limits[ls],
@@ -1187,7 +1187,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         ik_on=np.zeros(n, np.bool_), fk_feet=feet.copy(), hull=np.zeros(n), pelvis_rise=np.zeros(n), body_held=np.zeros(n, np.bool_), speed_limit=np.full(n, np.inf), last_move=np.zeros((n, 2)), cannot_follow=np.zeros((n, L), np.bool_), pose_before=np.zeros((n, 6)),
         gait_index=gait_index, stride_frequency=np.zeros(n),
         counters={k: 0 for k in ("steps", "plans", "holds", "replans", "forbidden_footprints", "cells_expanded",
-                                 "couples_evaluated", "pose_takebacks", "map_cells_built", "ik_legs_solved")},
+                                 "couples_evaluated", "pose_takebacks", "map_cells_built", "ik_ccd_legs", "ik_two_bone_legs")},
         lod_level=np.full(n, LEVEL_FULL, np.int8))
     stage_pelvis(model, state)
     state.pelvis_rise[:] = 0.0

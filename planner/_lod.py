@@ -52,7 +52,7 @@ class LodConfig:
     far_slice_m: float = 0.30  # beyond this interpolated size: no slices
     far_radius_cells: int = 1  # cells: candidate disc of a far foot's first try (planner._far_planning)
     far_margin_cells: int = 1  # cells: region-of-interest margin of a far foot's first try
-    far_fallback_margin_cells: int = 3  # cells: ... of its full first-valid search (the planner's: 6)
+    far_fallback_margin_cells: int = 6  # cells: ... of its full first-valid search (at most the planner's)
     hysteresis_m: float = 1.0  # back from LEVEL_FAR to LEVEL_FULL only this much nearer than far_m
 
     def __post_init__(self) -> None:
@@ -94,23 +94,26 @@ def look_at(position, target, fov: float) -> CameraPose:
 def frame_crowd(points: np.ndarray, fov: float, fraction: float = 1.0, focus: int | None = None,
                 elevation: float = 0.9) -> CameraPose:
     """A camera above and behind, looking at ``focus`` (or the centroid), at the smallest
-    distance (found by bisection) that puts at least ``fraction`` of the points on screen."""
+    distance that puts at least ``fraction`` of the points on screen.
+
+    In closed form (it runs every frame, over the whole crowd): seen from a camera at distance D
+    along the unit ``direction`` from the target, a point at offset q from the target, a = q .
+    direction along it and b across it, is inside the cone of half-angle h exactly when
+    D >= a + b / tan(h); the camera stands at the ``ceil(fraction n)``-th smallest of these
+    distances (at least 0.5 m), a hair further so that round-off keeps that point on screen.
+    """
     pts = np.asarray(points, dtype=np.float64)
     target = pts[focus] if focus is not None else pts.mean(axis=0)
     direction = np.array([-math.cos(elevation), math.sin(elevation), -0.3])
     direction /= np.linalg.norm(direction)
     need = max(1, int(math.ceil(fraction * len(pts))))
-
-    def enough(distance: float) -> bool:
-        return int(visibility(look_at(target + distance * direction, target, fov), pts)[0].sum()) >= need
-
-    lo, hi = 0.5, 1.0
-    while not enough(hi) and hi < 1e4:
-        lo, hi = hi, 2.0 * hi
-    for _ in range(30):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (lo, mid) if enough(mid) else (mid, hi)
-    return look_at(target + hi * direction, target, fov)
+    q = pts - target
+    along = q @ direction
+    across = np.sqrt(np.maximum(np.einsum("ij,ij->i", q, q) - along**2, 0.0))
+    needed = along + across / math.tan(0.5 * fov)
+    distance = max(0.5, float(np.partition(needed, need - 1)[need - 1]))
+    distance = distance * (1.0 + 1e-9) + 1e-9
+    return look_at(target + distance * direction, target, fov)
 
 
 def visibility(camera: CameraPose, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
