@@ -551,6 +551,11 @@ def _stance_unreachable_ahead(model: CrowdModel, state: CrowdState, hips, freque
     # Each character is checked every ``lookahead_every`` frames (in turns, so the cost is
     # spread); the look-ahead horizon covers the frames in between.
     turn = (np.arange(state.pelvis.shape[0]) + state.frame) % ctl.lookahead_every == 0
+    if model.lod_mode != "off":
+        # A far character (LOD) looks ahead half as often, within the horizon the check covers.
+        every = min(2 * ctl.lookahead_every, ctl.lookahead_frames)
+        far = _two_bone_characters(model, state)
+        turn = np.where(far, (np.arange(far.size) + state.frame) % every == 0, turn)
     cs, ls = np.nonzero(state.in_stance & (state.ik_on & turn)[:, None])
     if cs.size == 0:
         return out.copy()
@@ -672,10 +677,13 @@ def map_groups(model: CrowdModel, state: CrowdState, chars: np.ndarray) -> list[
 
 
 def stage_maps(model: CrowdModel, state: CrowdState, chars: np.ndarray, boxes, far: bool = False):
-    """Local maps of ``chars`` (the compact ones of far characters with ``far``):
-    (elevation, ground, forbidden, origin)."""
+    """Local maps of ``chars`` (with ``far``, the compact ones of a far character's first try; a
+    PlannerConfig: the maps of those settings): (elevation, ground, forbidden, origin)."""
     r = model.raster
-    config = model.far_fallback if far else model.config
+    if isinstance(far, PlannerConfig):
+        config = far
+    else:
+        config = model.far_first if far else model.config
     n = config.map_cells
     k = chars.size
     state.counters["map_cells_built"] += k * n * n
@@ -719,7 +727,7 @@ def _stamp_others(model: CrowdModel, state: CrowdState, chars: np.ndarray, forb,
                            0.5 * float(model.creature.foot_length))
 
 
-def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, maps, groups, hips):
+def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, maps, groups, hips, boxes=None):
     """Plan every request, one kernel call per map resolution (``groups`` and their ``maps``,
     :func:`map_groups`, :func:`stage_maps`); apply the results. Returns (the fine group's batch or
     None, the results of every request, the requests' characters, legs)."""
@@ -811,7 +819,7 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
         couples_after_first=couples[cs], slice_size=slices[cs],
         # the paper's early termination (§5.2) always, unless a fixed budget says otherwise
         early=np.full(f, model.fixed_budget is None or model.fixed_budget.paper_early_stop, np.bool_))
-    out, state.last_groups = _plan_groups(model, state, request, cs, maps, groups)
+    out, state.last_groups = _plan_groups(model, state, request, cs, maps, groups, boxes)
     batch = state.last_groups[0][0] if len(state.last_groups) == 1 and not groups[0][1] else None
     ok = out.valid
     vc, vl = cs[ok], ls[ok]
@@ -837,7 +845,7 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     return batch, out, cs, ls
 
 
-def _plan_groups(model: CrowdModel, state: CrowdState, request: FootBatch, cs, maps, groups):
+def _plan_groups(model: CrowdModel, state: CrowdState, request: FootBatch, cs, maps, groups, boxes):
     """Plan the requests of ``request`` (a FootBatch without maps, one row per request of character
     ``cs``) with the maps of their character's group; a far group first tries near the preferred
     footprint, then the full first-valid search for the feet left without a valid couple
@@ -860,8 +868,11 @@ def _plan_groups(model: CrowdModel, state: CrowdState, request: FootBatch, cs, m
         done.append((batch, config, rows, plan_batch(batch, model.weights, config, parallel=True)))
         missed = np.flatnonzero(~done[-1][3].valid) if far else np.zeros(0, np.int64)
         if missed.size:
-            retry = dataclasses.replace(_take_requests(batch, missed), elevation=elev, ground=ground, forbidden=forb,
-                                        origins=origin, foot_char=batch.foot_char[missed])
+            # The fallback's larger maps, for the characters with a foot to retry only.
+            again, foot_char = np.unique(batch.foot_char[missed], return_inverse=True)
+            wide = stage_maps(model, state, chars[again], boxes, model.far_fallback)
+            retry = dataclasses.replace(_take_requests(batch, missed), elevation=wide[0], ground=wide[1],
+                                        forbidden=wide[2], origins=wide[3], foot_char=foot_char.astype(np.int64))
             done.append((retry, model.far_fallback, rows[missed],
                          plan_batch(retry, model.weights, model.far_fallback, parallel=True)))
     if len(done) == 1:
@@ -1252,7 +1263,7 @@ def step(model: CrowdModel, state: CrowdState) -> dict[str, float]:
         groups = map_groups(model, state, chars)
         maps = [stage_maps(model, state, group, boxes, far) for group, far in groups]
         t5 = clock()
-        batch, out, cs, ls = stage_plan(model, state, kinds, frequency, budgets, maps, groups, hips)
+        batch, out, cs, ls = stage_plan(model, state, kinds, frequency, budgets, maps, groups, hips, boxes)
         state.last_plans = (cs, ls, kinds[cs, ls], out)
         state.last_batch = batch
     else:

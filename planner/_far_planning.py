@@ -19,7 +19,9 @@ about 25 x 25 cells for the spider), whatever the budget. Two things remove that
   cells, 451 with 6; the far characters' feet in boxes 139 with 3 cells, 62 with 6).
 
 Both run on compact local maps: the smallest window that holds every region of interest of the
-creature (:func:`compact_map_cells`), a fraction of the paper's 70 x 70 cells.
+creature (:func:`compact_map_cells`), a fraction of the paper's 70 x 70 cells (34 x 34 for the
+spider's first tries, 46 x 46 for its fallbacks); the fallback's maps are built only for the
+characters that have a foot to retry.
 
 Coarser cells (14 cm, 35 x 35) were tried first and refused: the other legs' projections block
 whole 14 cm cells, and around a spider's body those fill the gaps between legs (half the far
@@ -46,10 +48,13 @@ def compact_map_cells(config: PlannerConfig, span_m: float) -> int:
 def far_configs(config: PlannerConfig, span_m: float, radius_cells: int, margin_cells: int,
                 fallback_margin_cells: int) -> tuple[PlannerConfig, PlannerConfig]:
     """(first try, fallback) planner settings of a far character: the fallback is ``config`` with a
-    margin of ``fallback_margin_cells`` (at most the planner's) on the compact maps; the first try
-    also shrinks the candidate disc to ``radius_cells`` cells and the margin to ``margin_cells``."""
+    margin of ``fallback_margin_cells`` (at most the planner's) on its compact maps; the first try
+    also shrinks the candidate disc to ``radius_cells`` cells and the margin to ``margin_cells``, on
+    maps compact for that margin (smaller still: the fallback's maps are built only for the
+    characters with a foot that needs them)."""
     fallback = dataclasses.replace(config, roi_margin_cells=min(config.roi_margin_cells, fallback_margin_cells))
     fallback = dataclasses.replace(fallback, map_cells=compact_map_cells(fallback, span_m))
     first = dataclasses.replace(fallback, search_radius_m=min(config.search_radius_m, radius_cells * config.cell_size),
                                 roi_margin_cells=min(config.roi_margin_cells, margin_cells))
+    first = dataclasses.replace(first, map_cells=compact_map_cells(first, span_m))
     return first, fallback

@@ -73,7 +73,7 @@ def test_far_characters_build_smaller_maps_expand_fewer_cells_and_skip_ccd():
     assert per_plan["couples_evaluated"][0] < per_plan["couples_evaluated"][1], per_plan
     # CCD only where a pose is taken back (a stance leg that cannot follow); the rest is two-bone
     assert on.counters["ik_ccd_legs"] < 0.1 * off.counters["ik_ccd_legs"], on.counters
-    assert on.counters["ik_two_bone_legs"] > 0.9 * off.counters["ik_ccd_legs"], on.counters
+    assert on.counters["ik_two_bone_legs"] >= 12 * _SPIDER.n_legs * 30, on.counters  # every leg, every frame
     # ... and the crowd still walks: no more feet held for want of a couple than 1.5 x LOD off's
     assert on.counters["steps"] > 0.9 * off.counters["steps"]
     assert on.counters["holds"] <= 1.5 * off.counters["holds"] + 5
