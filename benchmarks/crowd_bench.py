@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from planner import PlannerConfig, WorldRaster
+from planner import WorldRaster
 from planner._crowd import init_crowd, step
 from scenarios import default_gait_name, load_creature, load_gait, load_scenario
 
@@ -66,16 +66,19 @@ def ratio_ci(on: np.ndarray, off: np.ndarray, seed: int = 0) -> tuple[float, flo
 
 
 def run(sizes=(100, 1000), frames: int = 60, warmup: int = 30, seed: int = 0, scenario_name: str = "mixed",
-        progress=None) -> dict:
-    creature = load_creature("spider")
-    gait = load_gait(default_gait_name("spider"), creature)
+        progress=None, creature_name: str = "spider") -> dict:
+    creature = load_creature(creature_name)
+    gait = load_gait(default_gait_name(creature.name), creature)
     out: dict = {}
     rasters: dict = {}
     for n in sizes:
         name = scenario_for(n, scenario_name)
         scenario = load_scenario(name)
         if name not in rasters:
-            rasters[name] = WorldRaster.build(scenario.terrain, scenario.obstacles, PlannerConfig().cell_size)
+            from planner._crowd import planner_config_for
+
+            rasters[name] = WorldRaster.build(scenario.terrain, scenario.obstacles,
+                                              planner_config_for(creature).cell_size)
         crowds = {mode: init_crowd(scenario, creature, gait, n_characters=n, seed=seed, lod_mode=mode,
                                    raster=rasters[name]) for mode in MODES}
         for k in range(warmup):

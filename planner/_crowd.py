@@ -226,8 +226,8 @@ class CrowdState:
     counters: dict = field(default_factory=dict)
     last_plans: object = None  # (chars, legs, kinds, BatchResult) of the last frame, for recordings
     last_batch: object = None  # the FootBatch planned in the last frame (what the tuning harvest re-scores)
-    # [(FootBatch, PlannerConfig, request rows)] of the last frame, one per map resolution: rows index
-    # last_plans' requests (a single fine group with LOD off, where last_batch is that group's batch).
+    # [(FootBatch, PlannerConfig, request rows, characters)] of the last frame, one per planning call: rows
+    # index last_plans' requests, the batch's foot_char indexes characters (LOD off: one call, last_batch's).
     last_groups: list = field(default_factory=list)
     lod_level: np.ndarray | None = None  # (C,) int8: each character's level of detail (planner._lod, LEVEL_*)
 
@@ -676,7 +676,8 @@ def map_groups(model: CrowdModel, state: CrowdState, chars: np.ndarray) -> list[
     return [(g, flag) for g, flag in ((chars[~far], False), (chars[far], True)) if g.size]
 
 
-def stage_maps(model: CrowdModel, state: CrowdState, chars: np.ndarray, boxes, far: bool = False):
+def stage_maps(model: CrowdModel, state: CrowdState, chars: np.ndarray, boxes, far: bool = False,
+               count: bool = True):
     """Local maps of ``chars`` (with ``far``, the compact ones of a far character's first try; a
     PlannerConfig: the maps of those settings): (elevation, ground, forbidden, origin)."""
     r = model.raster
@@ -686,7 +687,8 @@ def stage_maps(model: CrowdModel, state: CrowdState, chars: np.ndarray, boxes, f
         config = model.far_first if far else model.config
     n = config.map_cells
     k = chars.size
-    state.counters["map_cells_built"] += k * n * n
+    if count:  # (not the maps a report builds to measure, planner-free, what a plan lost)
+        state.counters["map_cells_built"] += k * n * n
     elev = np.empty((k, n, n))
     ground = np.empty((k, n, n))
     forb = np.empty((k, n, n), dtype=np.uint8)
@@ -850,7 +852,7 @@ def _plan_groups(model: CrowdModel, state: CrowdState, request: FootBatch, cs, m
     ``cs``) with the maps of their character's group; a far group first tries near the preferred
     footprint, then the full first-valid search for the feet left without a valid couple
     (planner._far_planning). Returns (the results of every request, [(FootBatch, PlannerConfig,
-    request rows)] per planning call)."""
+    request rows, the characters of the batch's maps)] per planning call)."""
     n = state.pelvis.shape[0]
     done = []
     for (chars, far), (elev, ground, forb, origin) in zip(groups, maps):
@@ -865,26 +867,26 @@ def _plan_groups(model: CrowdModel, state: CrowdState, request: FootBatch, cs, m
         batch = dataclasses.replace(sub, elevation=elev, ground=ground, forbidden=forb, origins=origin,
                                     foot_char=map_of[cs[rows]])
         config = model.far_first if far else model.config
-        done.append((batch, config, rows, plan_batch(batch, model.weights, config, parallel=True)))
-        missed = np.flatnonzero(~done[-1][3].valid) if far else np.zeros(0, np.int64)
+        done.append((batch, config, rows, chars, plan_batch(batch, model.weights, config, parallel=True)))
+        missed = np.flatnonzero(~done[-1][4].valid) if far else np.zeros(0, np.int64)
         if missed.size:
             # The fallback's larger maps, for the characters with a foot to retry only.
             again, foot_char = np.unique(batch.foot_char[missed], return_inverse=True)
             wide = stage_maps(model, state, chars[again], boxes, model.far_fallback)
             retry = dataclasses.replace(_take_requests(batch, missed), elevation=wide[0], ground=wide[1],
                                         forbidden=wide[2], origins=wide[3], foot_char=foot_char.astype(np.int64))
-            done.append((retry, model.far_fallback, rows[missed],
+            done.append((retry, model.far_fallback, rows[missed], chars[again],
                          plan_batch(retry, model.weights, model.far_fallback, parallel=True)))
     if len(done) == 1:
-        out = done[0][3]
+        out = done[0][4]
     else:
         # A retried foot's result replaces its first try's; the work of both is counted.
-        counters = np.zeros((cs.size,) + done[0][3].counters.shape[1:], np.int64)
-        for _, _, rows, result in done:
+        counters = np.zeros((cs.size,) + done[0][4].counters.shape[1:], np.int64)
+        for _, _, rows, _, result in done:
             counters[rows] += result.counters
-        out = _merge_results([(rows, result) for _, _, rows, result in done], cs.size)
+        out = _merge_results([(rows, result) for _, _, rows, _, result in done], cs.size)
         out.counters[:] = counters
-    return out, [(batch, config, rows) for batch, config, rows, _ in done]
+    return out, [(batch, config, rows, chars) for batch, config, rows, chars, _ in done]
 
 
 def _take_requests(request: FootBatch, rows: np.ndarray) -> FootBatch:

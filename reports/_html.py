@@ -106,7 +106,7 @@ TASK_COLUMNS = [(n, "") for n in ("scenario", "seed", "setting", "characters", "
 
 
 def write_index(path, *, analysis: dict, results: list[dict], meta: dict, scenes: list[dict],
-                recording: dict | None) -> None:
+                recording: dict | None, lod: dict | None = None) -> None:
     """Write ``index.html``. ``scenes``: per scenario, the relative image paths and render status."""
     rows = analysis["rows"]
     rec = next((r for r in rows if r["recommended"]), None)
@@ -157,6 +157,8 @@ def write_index(path, *, analysis: dict, results: list[dict], meta: dict, scenes
     parts.append(_table(rows, every_column, row_class))
     parts.append("</details>")
     parts.append(_img("pareto.png", "quality vs cost Pareto front"))
+    if lod is not None:
+        parts.extend(lod_section(lod))
     parts.append("<h2>Stride length vs speed</h2><p>Every pair of consecutive touch-downs of a foot in the "
                  "measured frames: the distance between the two footprints against the pelvis speed over that time; "
                  "the black line is the biomechanics target (Alexander 1976), the orange one the median realised stride "
@@ -193,3 +195,33 @@ def write_index(path, *, analysis: dict, results: list[dict], meta: dict, scenes
     parts.append(f"</details><p>Score-loss tolerance of the rule: {LOSS_TOLERANCE_PCT} points.</p></body></html>")
     with open(path, "w", encoding="utf-8") as fh:
         fh.write("\n".join(parts))
+
+
+def lod_section(lod: dict) -> list[str]:
+    """The level-of-detail section: cost against crowd size, and quality per level (issue 15)."""
+    from reports._lod_report import LEVEL_TABLE
+
+    parts = ["<h2>Level of detail: cost and quality per level</h2>"]
+    if lod["scaling"]:
+        ratios = {}
+        for r in lod["scaling"]:
+            ratios[r["scenario"], r["characters"]] = (r["ratio_on_off"], r["ratio_ci_low"], r["ratio_ci_high"])
+        said = "; ".join(f"{n} characters on {sc}: {v[0]:.2f} (95 % {v[1]:.2f}-{v[2]:.2f})"
+                         for (sc, n), v in sorted(ratios.items(), key=lambda kv: (kv[0][0], kv[0][1])))
+        parts.append("<p>Cost: one crowd per LOD mode, the three stepped in turns (a frame each, the order rotating), "
+                     "so they share whatever load the machine has; the median ms per frame with the 95 % interval of "
+                     f"that median. LOD on / LOD off: {html.escape(said)} (bootstrap over the rounds). A far character "
+                     "(on screen beyond LodConfig.far_m) plans on compact maps, first near its preferred footprint, and "
+                     "solves its legs in closed form; an off-screen one plans the same way and has no IK "
+                     "(<code>planner._lod</code>). Data: <a href='lod_scaling.csv'>lod_scaling.csv</a>.</p>")
+        parts.append(_img("lod_scaling.png", "ms per frame against crowd size per LOD mode"))
+    if lod["levels"]:
+        parts.append("<p>Quality per level, measured on what is rendered in the sweep's LOD runs: each "
+                     "character-frame counts at the level its character had then; the couple-score loss is that of "
+                     "the level's plans against the exhaustive search on the same requests (the far plans put back on "
+                     "the paper's maps). A pop is the largest move of a rendered foot beyond its planned foot's in a "
+                     "frame where its character switched level. Hover a column name for its meaning; every column "
+                     "(strides measured, jumps without a switch, switches, runs) is in "
+                     "<a href='lod_levels.csv'>lod_levels.csv</a>.</p>")
+        parts.append(_table(lod["levels"], [(name, unit) for name, unit in LEVEL_TABLE]))
+    return parts

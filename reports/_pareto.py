@@ -124,7 +124,7 @@ def analyse(results: list[dict], tolerance_pct: float = LOSS_TOLERANCE_PCT) -> d
     The paired runs (every budget on the same situations) give the budgets'
     ``paired_us_per_foot`` and ``paired_loss_pct``, the axes of the front.
     """
-    rows = summarise([r for r in results if r["kind"] != "paired"])
+    rows = summarise([r for r in results if r["kind"] not in ("paired", "lod-scaling")])
     paired: dict[str, list[dict]] = defaultdict(list)
     for r in results:
         if r["kind"] == "paired":

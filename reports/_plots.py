@@ -4,7 +4,8 @@
   the recommended budget;
 * :func:`stride_plot`: realised stride length vs speed against lambda = 2.3 h Fr^0.3;
 * :func:`gait_disks`: the gait manager's disks (paper Fig. 8);
-* :func:`footprint_heatmap`: candidate footprints and trajectories of one plan (paper Fig. 13).
+* :func:`footprint_heatmap`: candidate footprints and trajectories of one plan (paper Fig. 13);
+* :func:`lod_scaling_plot`: ms per frame against crowd size per LOD mode, with 95 % intervals.
 """
 
 from __future__ import annotations
@@ -285,3 +286,42 @@ def _scalar_mappable(norm=None):
     from matplotlib.colors import Normalize
 
     return ScalarMappable(norm=norm or Normalize(0.0, 1.0), cmap=SCORE_COLOURS)
+
+
+MODE_COLOURS = {"on": "#4c72b0", "zoomed": "#55a868", "off": "#c44e52"}
+
+
+def lod_scaling_plot(scaling: list[dict], path) -> None:
+    """Median ms per frame against crowd size (log-log), one line per LOD mode and scenario, the
+    bars the 95 % interval of each median (the modes stepped in turns: the same load for all)."""
+    fig = Figure(figsize=(7.5, 4.6), layout="constrained")
+    ax = fig.subplots()
+    styles = ("-", "--", ":", "-.")
+    for k, task in enumerate(scaling):
+        sizes = sorted(task["sizes"], key=int)
+        x = np.array([int(n) for n in sizes], dtype=np.float64)
+        for mode in ("on", "zoomed", "off"):
+            rows = [task["sizes"][n][mode] for n in sizes]
+            y = np.array([r["ms_per_frame"] for r in rows])
+            lo = np.array([r["ms_per_frame_ci"][0] for r in rows])
+            hi = np.array([r["ms_per_frame_ci"][1] for r in rows])
+            ax.errorbar(x, y, yerr=[y - lo, hi - y], marker="o", ms=4, capsize=3, ls=styles[k % len(styles)],
+                        c=MODE_COLOURS[mode], label=f"LOD {mode}" + (f", {task['scenario']}" if len(scaling) > 1 else ""))
+        for n, xv in zip(sizes, x):
+            r = task["sizes"][n]
+            ax.annotate(f"on/off {r['ratio_on_off']:.2f}", (xv, r["on"]["ms_per_frame"]), textcoords="offset points",
+                        xytext=(4, -12), fontsize=7, color=MODE_COLOURS["on"])
+    from matplotlib.ticker import NullFormatter, ScalarFormatter
+
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    for axis in (ax.xaxis, ax.yaxis):
+        axis.set_major_formatter(ScalarFormatter())
+        axis.set_minor_formatter(NullFormatter())
+    ax.set_xticks([int(n) for task in scaling for n in task["sizes"]])
+    ax.set_xlabel("characters")
+    ax.set_ylabel("ms per frame (median, 95 % interval)")
+    ax.set_title("Cost of a frame against crowd size, per LOD mode (modes stepped in turns)")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=8)
+    _save(fig, path)
