@@ -91,7 +91,7 @@ SUMMARY_COLUMNS = [
     ("paired_loss_pct", "% of the exhaustive couple score lost, all budgets on the same requests", "loss %"),
     ("score_loss_pct", "% of the exhaustive couple score lost in the setting's own runs", "own loss %"),
     ("plan_us_per_foot", "µs per foot plan (own runs, one core)", "µs / foot plan"),
-    ("ms_per_character", "ms per character per frame (median frame)", "ms / character"),
+    ("paired_cost_ci", "95 % interval of the cost (over the batches planned by every budget)", "cost 95 % CI"),
     ("collisions", "feet in boxes (feet x frames)", "collisions"),
     ("leg_crossings", "crossing leg pairs (x frames)", "leg crossings"),
     ("stride_error_median", "median |stride - target| / target", "stride error"),
@@ -127,10 +127,17 @@ def write_index(path, *, analysis: dict, results: list[dict], meta: dict, scenes
             f"{_fmt(rec['slice_size_m'])} m): {rec['paired_cost_vs_first_valid']:.3f} x the first valid couple's "
             f"planning time ({rec['paired_us_per_foot']:.1f} µs per foot plan), "
             f"{rec['paired_loss_pct']:.3f} % of the exhaustive couple score lost (every budget planning the same "
-            "requests).<br>Rule: among the fixed budgets, the cheapest (planning time relative to the first valid "
-            "couple's) whose score loss is at most "
-            f"{analysis['tolerance_pct']} percentage points above the smallest loss of any budget; it is always on the "
-            "Pareto front.</div>")
+            "requests).<br>Rule: among the fixed budgets whose score loss is at most "
+            f"{analysis['tolerance_pct']} percentage points above the smallest loss of any budget, the cheapest "
+            "(planning time relative to the first valid couple's), where cheaper means by more than the noise: the "
+            "budgets whose 95 % cost interval overlaps the cheapest one's count as just as cheap, and of those the one "
+            "losing least is recommended.</div>")
+    far = analysis.get("far_level")
+    if far is not None and far.get("paired_cost_vs_first_valid") is not None:
+        parts.append(f"<p>The far level of detail's planning on the same requests: {far['paired_cost_vs_first_valid']:.3f} "
+                     f"x the first valid couple's time (95 % {_fmt(far['paired_cost_ci_low'])}-"
+                     f"{_fmt(far['paired_cost_ci_high'])}), {far['paired_loss_pct']:.3f} % of the exhaustive couple "
+                     "score lost (<code>planner._far_planning</code>).</p>")
     parts.append("<h2>Quality vs cost</h2>"
                  "<p>Cost: the planning time per foot relative to the first valid couple's on the same requests "
                  "(timed alternately on one core, so the load of other programs cancels out) and in µs, the crowd's "

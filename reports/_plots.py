@@ -33,8 +33,20 @@ def pareto_plot(analysis: dict, path) -> None:
     cost, loss = analysis["cost_axis"], analysis["loss_axis"]
     budgets = [r for r in rows if r["kind"] == "budget" and r[cost] is not None]
     lods = [r for r in rows if r["kind"] == "lod"]
-    ax.scatter([r[cost] for r in budgets], [r[loss] for r in budgets], c="#4c72b0",
-               label="fixed budget (all on the same requests)", zorder=3)
+    def xerr(rs):
+        return [[r[cost] - (r.get("paired_cost_ci_low") if r.get("paired_cost_ci_low") is not None else r[cost])
+                 for r in rs],
+                [(r.get("paired_cost_ci_high") if r.get("paired_cost_ci_high") is not None else r[cost]) - r[cost]
+                 for r in rs]]
+
+    ax.errorbar([r[cost] for r in budgets], [r[loss] for r in budgets], xerr=xerr(budgets), fmt="o", c="#4c72b0",
+                capsize=3, label="fixed budget, 95 % interval of its cost (all on the same requests)", zorder=3)
+    far = analysis.get("far_level")
+    if far is not None and far[cost] is not None:
+        ax.errorbar([far[cost]], [far[loss]], xerr=xerr([far]), fmt="D", c="#8172b2", capsize=3, zorder=3,
+                    label="far level of detail's planning (same requests)")
+        ax.annotate("LOD far", (far[cost], far[loss]), textcoords="offset points", xytext=(4, 4), fontsize=7,
+                    color="#8172b2")
     for r in budgets:
         ax.annotate(r["setting"].removeprefix("budget-"), (r[cost], r[loss]),
                     textcoords="offset points", xytext=(4, 4), fontsize=7)
@@ -52,6 +64,9 @@ def pareto_plot(analysis: dict, path) -> None:
     if rec is not None:
         ax.scatter([rec[cost]], [rec[loss]], marker="*", s=260, c="#c44e52",
                    edgecolors="k", zorder=4, label=f"recommended: {rec['setting']}")
+    # The whole range from no work: the differences between budgets are read against the noise bars,
+    # not against an axis zoomed onto them.
+    ax.set_xlim(left=0.0)
     ax.set_xlabel("cost: time per foot plan / the first valid couple's (same requests, interleaved)")
     ax.set_ylabel("quality loss: % of the exhaustive couple score")
     ax.set_title("Search budget: quality vs cost")

@@ -236,7 +236,8 @@ def build_report(out, *, preset: str = "default", scenarios: tuple[str, ...] | N
                     "wall_seconds": time.perf_counter() - t_start}
             _write_csv(tmp / "results.csv", runs, task_columns(runs))
             paired_rows = [{"scenario": r["scenario"], "seed": r["seed"], "characters": r["characters"],
-                            "situations": r["situations"], **b} for r in results if r["kind"] == "paired"
+                            "situations": r["situations"], **{k: v for k, v in b.items() if k != "cost_ratios"}}
+                           for r in results if r["kind"] == "paired"
                            for b in r["budgets"]]
             if paired_rows:
                 _write_csv(tmp / "paired.csv", paired_rows, list(paired_rows[0]))

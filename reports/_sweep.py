@@ -279,13 +279,37 @@ def _take_result(out, rows):
 
 def _time_interleaved(batches, weights, config, rounds: int = TIMING_REPEATS) -> np.ndarray:
     """Seconds to plan each batch on one core: best of ``rounds``, the order rotating each round."""
-    best = np.full(len(batches), np.inf)
+    return _time_calls([functools.partial(plan_batch, b, weights, config, "search", False) for b in batches], rounds)
+
+
+def _time_calls(calls, rounds: int = TIMING_REPEATS) -> np.ndarray:
+    """Seconds of each call: best of ``rounds``, the order rotating each round."""
+    best = np.full(len(calls), np.inf)
     for r in range(rounds):
-        for j in np.roll(np.arange(len(batches)), r):
+        for j in np.roll(np.arange(len(calls)), r):
             t0 = time.perf_counter()
-            plan_batch(batches[j], weights, config, "search", False)
+            calls[j]()
             best[j] = min(best[j], time.perf_counter() - t0)
     return best
+
+
+def plan_far(batch, weights, first, fallback):
+    """A far character's planning (``planner._far_planning``) of ``batch`` on one core: the first
+    try near the preferred footprints, the full first-valid search for the feet it left without a
+    couple. Returns the BatchResult of every foot."""
+    from planner._crowd import _merge_results, _take_requests
+    from planner._params import FIRST_VALID
+
+    batch = with_budget(batch, *FIRST_VALID.kernel_args())
+    out = plan_batch(batch, weights, first, "search", False)
+    missed = np.flatnonzero(~out.valid)
+    if missed.size == 0:
+        return out
+    retry = dataclasses.replace(_take_requests(batch, missed), elevation=batch.elevation, ground=batch.ground,
+                                forbidden=batch.forbidden, origins=batch.origins, foot_char=batch.foot_char[missed])
+    again = plan_batch(retry, weights, fallback, "search", False)
+    return _merge_results([(np.flatnonzero(out.valid), _take_result(out, np.flatnonzero(out.valid))),
+                           (missed, again)], batch.n_feet)
 
 
 # --------------------------------------------------------------------------- metrics
@@ -476,6 +500,9 @@ def run_lod_scaling(task: dict) -> dict:
             "sizes": sizes}
 
 
+FAR_LEVEL = "lod-far-planning"
+"""The paired benchmark's row of the far level of detail's planning (``planner._far_planning``:
+first valid couple, first near the preferred footprint), beside the fixed budgets."""
 PAIRED_KEEP_EVERY = 3  # planning calls (frames) between two kept for the paired benchmark
 PAIRED_KEEP_FEET = 800  # bounds the memory of the kept local maps (~100 MB at 100 characters)
 
@@ -500,7 +527,16 @@ def run_paired(task: dict) -> dict:
         from planner import SearchBudget
 
         args.append(SearchBudget(p["couples_after_first"], p["slice_size_m"], paper_early_stop=True).kernel_args())
+    from planner._far_planning import far_configs
+    from planner._lod import LodConfig
+
+    lod = LodConfig()
+    span = model.rest_radius + model.config.search_radius_m + float(np.max(model.reach))
+    first, fallback = far_configs(model.config, span, lod.far_radius_cells, lod.far_margin_cells,
+                                  lod.far_fallback_margin_cells)
+    names = names + [FAR_LEVEL]  # the far level of detail's planning, on the same requests
     seconds = np.zeros(len(names) + 1)  # the last: the first valid couple, the reference of the cost ratios
+    ratios = [[] for _ in names]  # per kept batch: each variant's time / the first valid couple's
     chosen = np.zeros(len(names))
     suboptimal = np.zeros(len(names))
     best_total = 0.0
@@ -512,17 +548,23 @@ def run_paired(task: dict) -> dict:
         best_total += float(exhaustive.scores[ok, 0].sum())
         feet += int(ok.sum())
         variants = [with_budget(batch, *a) for a in args] + [with_budget(batch, *FIRST_VALID.kernel_args())]
-        for j, variant in enumerate(variants[:-1]):
-            out = plan_batch(variant, weights, config, "search", False)
+        calls = [functools.partial(plan_batch, v, weights, config, "search", False) for v in variants]
+        calls.insert(len(args), functools.partial(plan_far, batch, weights, first, fallback))
+        for j, call in enumerate(calls[:-1]):
+            out = call()
             got = np.where(out.valid[ok], out.scores[ok, 0], 0.0)
             chosen[j] += float(got.sum())
             suboptimal[j] += float((exhaustive.scores[ok, 0] - got > 1e-9).sum())
-        seconds += _time_interleaved(variants, weights, config)
+        timed = _time_calls(calls)
+        seconds += timed
+        for j in range(len(names)):
+            ratios[j].append(float(timed[j] / timed[-1]) if timed[-1] > 0 else None)
     all_feet = sum(b.n_feet for b, _, _ in tap.kept)
     rows = []
     for j, name in enumerate(names):
         rows.append({"budget": name, "us_per_foot": float(1e6 * seconds[j] / max(all_feet, 1)),
                      "cost_vs_first_valid": float(seconds[j] / seconds[-1]) if seconds[-1] > 0 else None,
+                     "cost_ratios": [r for r in ratios[j] if r is not None],
                      "score_loss_pct": float(100.0 * (1.0 - chosen[j] / best_total)) if best_total > 0 else 0.0,
                      "suboptimal_fraction": float(suboptimal[j] / max(feet, 1))})
     return {"kind": "paired", "scenario": scenario.name, "seed": task["seed"], "characters": task["characters"],
