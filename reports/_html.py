@@ -164,8 +164,6 @@ def write_index(path, *, analysis: dict, results: list[dict], meta: dict, scenes
     parts.append(_table(rows, every_column, row_class))
     parts.append("</details>")
     parts.append(_img("pareto.png", "quality vs cost Pareto front"))
-    if lod is not None:
-        parts.extend(lod_section(lod))
     parts.append("<h2>Stride length vs speed</h2><p>Every pair of consecutive touch-downs of a foot in the "
                  "measured frames: the distance between the two footprints against the pelvis speed over that time; "
                  "the black line is the biomechanics target (Alexander 1976), the orange one the median realised stride "
@@ -175,6 +173,8 @@ def write_index(path, *, analysis: dict, results: list[dict], meta: dict, scenes
                  "characters and turns moving footprints off their preferred points. At low speeds the gait keeps a "
                  "minimum stride frequency, so strides are shorter than the target there by design.</p>")
     parts.append(_img("stride.png", "stride length vs speed"))
+    if lod is not None:
+        parts.extend(lod_section(lod))
     for s in scenes:
         parts.append(f"<h2>Scenario {html.escape(s['scenario'])}</h2>")
         parts.append(f"<p>{html.escape(s['caption'])}</p><div class='pair'>")
