@@ -676,18 +676,16 @@ def map_groups(model: CrowdModel, state: CrowdState, chars: np.ndarray) -> list[
     return [(g, flag) for g, flag in ((chars[~far], False), (chars[far], True)) if g.size]
 
 
-def stage_maps(model: CrowdModel, state: CrowdState, chars: np.ndarray, boxes, far: bool = False,
+def stage_maps(model: CrowdModel, state: CrowdState, chars: np.ndarray, boxes, config: PlannerConfig | None = None,
                count: bool = True):
-    """Local maps of ``chars`` (with ``far``, the compact ones of a far character's first try; a
-    PlannerConfig: the maps of those settings): (elevation, ground, forbidden, origin)."""
+    """Local maps of ``chars``, ``config.map_cells`` a side (the planner's by default; compact for the
+    far characters, planner._far_planning): (elevation, ground, forbidden, origin). ``count``: add
+    their cells to the work counters (not for maps built to measure a run, outside its frames)."""
     r = model.raster
-    if isinstance(far, PlannerConfig):
-        config = far
-    else:
-        config = model.far_first if far else model.config
+    config = config or model.config
     n = config.map_cells
     k = chars.size
-    if count:  # (not the maps a report builds to measure, planner-free, what a plan lost)
+    if count:
         state.counters["map_cells_built"] += k * n * n
     elev = np.empty((k, n, n))
     ground = np.empty((k, n, n))
@@ -730,9 +728,10 @@ def _stamp_others(model: CrowdModel, state: CrowdState, chars: np.ndarray, forb,
 
 
 def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, maps, groups, hips, boxes=None):
-    """Plan every request, one kernel call per map resolution (``groups`` and their ``maps``,
-    :func:`map_groups`, :func:`stage_maps`); apply the results. Returns (the fine group's batch or
-    None, the results of every request, the requests' characters, legs)."""
+    """Plan every request, one kernel call per planning group (``groups`` and their ``maps``,
+    :func:`map_groups`, :func:`stage_maps`; a far group's fallback is one more); apply the results.
+    Returns (the batch of the one near group, or None, the results of every request, the requests'
+    characters, legs)."""
     cs, ls = np.nonzero(kinds)
     f = cs.size
     n_legs = model.n_legs
@@ -1263,7 +1262,7 @@ def step(model: CrowdModel, state: CrowdState) -> dict[str, float]:
     chars = np.unique(np.nonzero(kinds)[0])
     if chars.size:
         groups = map_groups(model, state, chars)
-        maps = [stage_maps(model, state, group, boxes, far) for group, far in groups]
+        maps = [stage_maps(model, state, group, boxes, model.far_first if far else None) for group, far in groups]
         t5 = clock()
         batch, out, cs, ls = stage_plan(model, state, kinds, frequency, budgets, maps, groups, hips, boxes)
         state.last_plans = (cs, ls, kinds[cs, ls], out)

@@ -19,7 +19,7 @@ about 25 x 25 cells for the spider), whatever the budget. Two things remove that
   cells, 451 with 6; the far characters' feet in boxes 139 with 3 cells, 62 with 6).
 
 Both run on compact local maps: the smallest window that holds every region of interest of the
-creature (:func:`compact_map_cells`), a fraction of the paper's 70 x 70 cells (34 x 34 for the
+creature (:func:`compact_map_cells`), a fraction of the paper's 70 x 70 cells (36 x 36 for the
 spider's first tries, 46 x 46 for its fallbacks); the fallback's maps are built only for the
 characters that have a foot to retry.
 
