@@ -230,6 +230,7 @@ class CrowdState:
     # index last_plans' requests, the batch's foot_char indexes characters (LOD off: one call, last_batch's).
     last_groups: list = field(default_factory=list)
     lod_level: np.ndarray | None = None  # (C,) int8: each character's level of detail (planner._lod, LEVEL_*)
+    near_moving_box: np.ndarray | None = None  # (C,) bool: a moving box is near: it plans as a near character
 
 
 def hips_world(model: CrowdModel, state: CrowdState) -> np.ndarray:
@@ -664,7 +665,35 @@ def character_budgets(model: CrowdModel, state: CrowdState):
     on_screen, distance = visibility(camera, state.pelvis)
     couples, slices = lod_budgets(on_screen, distance, model.lod)
     state.lod_level = lod_levels(on_screen, distance, state.lod_level, model.lod)
+    # A moving box near a character makes its feet's choices matter whatever the camera sees: it
+    # plans on the paper's maps and weighs at least ``moving_box_couples`` couples after the first
+    # valid one (its IK keeps its level). With the first valid couple far feet stood in the crates'
+    # way more often: 1000 spiders on mixed, 120 frames, seeds 0-2: 1031 feet in moving boxes,
+    # 813 with LOD off, 839 with two couples near the crates.
+    near = moving_box_near(model, state)
+    state.near_moving_box = near
+    couples = np.where(near, np.maximum(couples, model.lod.moving_box_couples), couples)
     return couples, slices, on_screen
+
+
+def moving_box_near(model: CrowdModel, state: CrowdState) -> np.ndarray:
+    """(C,) characters within ``LodConfig.moving_box_margin_m`` of a moving box's reach: the box's
+    bounding circle grown by how far the character's feet plan (its rest radius, candidate disc and
+    leg reach) and the margin."""
+    obs = model.raster.obstacles
+    n = state.pelvis.shape[0]
+    if not len(obs.yaws):
+        return np.zeros(n, np.bool_)
+    moving = ~np.asarray(obs.is_static, dtype=np.bool_)
+    if not moving.any():
+        return np.zeros(n, np.bool_)
+    centres, _ = obs.poses_at(state.t)
+    centres = centres[moving][:, [0, 2]]
+    radius = 0.5 * np.hypot(obs.sizes[moving, 0], obs.sizes[moving, 2])
+    span = model.rest_radius + model.config.search_radius_m + float(np.max(model.reach))
+    reach = radius + span + model.lod.moving_box_margin_m  # (B,)
+    d = np.hypot(state.pelvis[:, None, 0] - centres[None, :, 0], state.pelvis[:, None, 2] - centres[None, :, 1])
+    return (d < reach[None, :]).any(axis=1)
 
 
 def map_groups(model: CrowdModel, state: CrowdState, chars: np.ndarray) -> list[tuple[np.ndarray, bool]]:
@@ -672,7 +701,7 @@ def map_groups(model: CrowdModel, state: CrowdState, chars: np.ndarray) -> list[
     first; one near group of them all with LOD off (the maps and the plan of the paper)."""
     if model.far_first is None:
         return [(chars, False)]
-    far = state.lod_level[chars] != LEVEL_FULL
+    far = (state.lod_level[chars] != LEVEL_FULL) & ~state.near_moving_box[chars]
     return [(g, flag) for g, flag in ((chars[~far], False), (chars[far], True)) if g.size]
 
 
@@ -960,9 +989,18 @@ def stage_ik(model: CrowdModel, state: CrowdState, on_screen: np.ndarray) -> Non
     if far.any():
         cs, ls = np.nonzero(np.broadcast_to(far[:, None], state.in_stance.shape))
         res = _solve_feet(model, state, cs, ls, hips[cs, ls], 1, 0, two_bone=True)
-        state.angles[cs, ls] = res.angles
-        state.residual[cs, ls] = res.residual
-        state.fk_feet[cs, ls] = res.feet
+        # Where the closed form (and its one sweep) leaves a foot, the CCD of the near characters
+        # takes over from the last pose: a far leg is never drawn short of a foot the CCD reaches.
+        short = res.residual > ctl.ik_slip_margin
+        state.angles[cs[~short], ls[~short]] = res.angles[~short]
+        state.residual[cs[~short], ls[~short]] = res.residual[~short]
+        state.fk_feet[cs[~short], ls[~short]] = res.feet[~short]
+        if short.any():
+            cs, ls = cs[short], ls[short]
+            again = _solve_feet(model, state, cs, ls, hips[cs, ls], ctl.ik_iterations, ctl.ik_restarts)
+            state.angles[cs, ls] = again.angles
+            state.residual[cs, ls] = again.residual
+            state.fk_feet[cs, ls] = again.feet
     state.ik_on[on_screen] = True
     _take_back_unfollowed_poses(model, state, on_screen)
 
@@ -1200,7 +1238,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         gait_index=gait_index, stride_frequency=np.zeros(n),
         counters={k: 0 for k in ("steps", "plans", "holds", "replans", "forbidden_footprints", "cells_expanded",
                                  "couples_evaluated", "pose_takebacks", "map_cells_built", "ik_ccd_legs", "ik_two_bone_legs")},
-        lod_level=np.full(n, LEVEL_FULL, np.int8))
+        lod_level=np.full(n, LEVEL_FULL, np.int8), near_moving_box=np.zeros(n, np.bool_))
     stage_pelvis(model, state)
     state.pelvis_rise[:] = 0.0
     state.pose_before = _pose(state)  # nothing to take back before the first frame

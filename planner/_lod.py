@@ -20,7 +20,11 @@ the IK cost the same for every budget (issue 15). So each character also gets a 
 * ``LEVEL_HIDDEN`` (off screen): the far planning and no IK.
 
 A character moves to a farther level at ``far_m`` and back to a nearer one only
-``hysteresis_m`` closer, so one walking along the boundary does not flip every frame.
+``hysteresis_m`` closer, so one walking along the boundary does not flip every frame. A
+character near a moving box (within ``moving_box_margin_m`` of its reach, about what a crate
+covers while a foot stands) plans on the paper's maps with at least ``moving_box_couples`` couples
+after the first valid one, whatever its level (its IK keeps its level): with the first valid
+couple, far feet stood in the crates' way more often (``planner._crowd.character_budgets``).
 
 Modes of the paper's Table 1: ``on`` (the camera frames the whole crowd),
 ``zoomed`` (the camera follows character 0, zoomed so that about half the crowd
@@ -54,13 +58,18 @@ class LodConfig:
     far_margin_cells: int = 1  # cells: region-of-interest margin of a far foot's first try
     far_fallback_margin_cells: int = 6  # cells: ... of its full first-valid search (at most the planner's)
     hysteresis_m: float = 1.0  # back from LEVEL_FAR to LEVEL_FULL only this much nearer than far_m
+    moving_box_margin_m: float = 0.3  # m: a character this near a moving box's reach plans as a near one
+    moving_box_couples: int = 2  # ... and weighs at least this many couples after the first valid one
 
     def __post_init__(self) -> None:
-        for name, least in (("far_radius_cells", 1), ("far_margin_cells", 0), ("far_fallback_margin_cells", 0),
-):
+        integers = (("far_radius_cells", 1), ("far_margin_cells", 0), ("far_fallback_margin_cells", 0),
+                    ("moving_box_couples", 0))
+        for name, least in integers:
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < least:
                 raise ValueError(f"LodConfig.{name}: expected an integer >= {least}, got {v!r}")
+        if not (isinstance(self.moving_box_margin_m, (int, float)) and self.moving_box_margin_m >= 0.0):
+            raise ValueError(f"LodConfig.moving_box_margin_m: expected a number >= 0, got {self.moving_box_margin_m!r}")
         if not (isinstance(self.hysteresis_m, (int, float)) and 0.0 <= self.hysteresis_m < self.far_m):
             raise ValueError(f"LodConfig.hysteresis_m: expected a number in [0, far_m), got {self.hysteresis_m!r}")
         if not (0 <= self.near_m < self.far_m):

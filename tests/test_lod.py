@@ -117,3 +117,29 @@ def test_switching_levels_does_not_pop_and_lod_off_has_no_levels():
         assert row["max_stance_slip_m"] < 1e-3, (name, row)
     model, state = _crowd("off", 2)
     assert simulate(model, state, 3).lod_levels is None
+
+
+def test_far_characters_near_a_moving_box_plan_on_the_papers_maps_with_more_couples():
+    """The first valid couple put far feet in the crates' way: a far character near a moving box
+    plans in the near group (70 x 70 maps) and weighs at least moving_box_couples couples."""
+    far = LodConfig(near_m=0.0, far_m=0.01, hysteresis_m=0.0, moving_box_couples=3)
+    model, state = _crowd("on", 12, lod=far)
+    seen = 0
+    for _ in range(40):
+        step(model, state)
+        if state.last_plans is None:
+            continue
+        cs = state.last_plans[0]
+        near = state.near_moving_box[cs]
+        for batch, config, rows, chars in state.last_groups:
+            moved = state.near_moving_box[cs[rows]]
+            if config is model.config:
+                assert batch.elevation.shape[1] == model.config.map_cells
+                assert (batch.couples_after_first[moved] >= 3).all()
+                seen += int(moved.sum())
+            else:
+                assert not moved.any()  # far planning only away from moving boxes
+        assert near.sum() == sum(int(state.near_moving_box[cs[rows]].sum()) for _, c, rows, _ in state.last_groups
+                                 if c is model.config)
+    assert seen > 0  # the crowd met a moving box
+    assert (state.lod_level == LEVEL_FAR).all()  # ... and its IK kept its level
