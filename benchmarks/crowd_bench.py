@@ -39,18 +39,18 @@ def scenario_for(n: int, scenario_name: str = "mixed") -> str:
     return scenario_name if n <= SMALL_WORLD_MAX or scenario_name != "mixed" else LARGE_SCENARIO
 
 
-def median_ci(values: np.ndarray, level: float = 0.95) -> tuple[float, float]:
-    """Distribution-free interval of the median of ``values``: the order statistics whose ranks
-    bracket n/2 by 1.96 sqrt(n)/2 (the binomial's normal approximation).
+def median_ci(values) -> tuple[float, float]:
+    """Distribution-free 95 % interval of the median of ``values``: the order statistics whose
+    ranks bracket n/2 by 1.96 sqrt(n)/2 (the binomial's normal approximation).
 
     Examples
     --------
     >>> median_ci(np.arange(100.0))
-    (39.0, 60.0)
+    (40.0, 60.0)
     """
     v = np.sort(np.asarray(values, dtype=np.float64))
     n = v.size
-    half = 1.96 * np.sqrt(n) / 2.0 if level == 0.95 else float(level) * np.sqrt(n)
+    half = 1.96 * np.sqrt(n) / 2.0
     lo = int(max(0, np.floor(n / 2.0 - half)))
     hi = int(min(n - 1, np.ceil(n / 2.0 + half)))
     return float(v[lo]), float(v[hi])

@@ -617,7 +617,7 @@ def bench_crowd_cmd(
         lo, hi = modes["ratio_on_off_ci"]
         table = Table(title=f"{n} spiders on {modes['scenario']} (median ms per frame; LOD on / off = "
                             f"{modes['ratio_on_off']:.2f}, 95 % CI {lo:.2f}-{hi:.2f})")
-        for col in ("LOD", "total for characters", "95 % CI", "maps preparation", "planning", "CCD IK",
+        for col in ("LOD", "total for characters", "95 % CI", "maps preparation", "planning", "IK",
                     "average FPS"):
             table.add_column(col, justify="right")
         for mode in ("on", "zoomed", "off"):

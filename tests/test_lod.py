@@ -143,3 +143,21 @@ def test_far_characters_near_a_moving_box_plan_on_the_papers_maps_with_more_coup
                                  if c is model.config)
     assert seen > 0  # the crowd met a moving box
     assert (state.lod_level == LEVEL_FAR).all()  # ... and its IK kept its level
+
+
+def test_bench_crowd_reports_every_mode_with_intervals_and_the_on_off_ratio():
+    from benchmarks.crowd_bench import LARGE_SCENARIO, MODES, scenario_for
+    from benchmarks.crowd_bench import run as bench
+
+    out = bench(sizes=(6,), frames=4, warmup=1)
+    row = out["6"]
+    assert set(MODES) <= set(row) and row["scenario"] == "mixed"
+    for mode in MODES:
+        lo, hi = row[mode]["ms_per_frame_ci"]
+        assert lo <= row[mode]["ms_per_frame"] <= hi
+        assert row[mode]["plans_per_frame"] >= 0 and row[mode]["map_cells_built_per_frame"] > 0
+    assert row["ratio_on_off"] == pytest.approx(row["on"]["ms_per_frame"] / row["off"]["ms_per_frame"])
+    assert row["ratio_on_off_ci"][0] <= row["ratio_on_off"] <= row["ratio_on_off_ci"][1]
+    # 3000 and 5000 spiders do not fit mixed's 20 m square: the same scenario on a 60 m one
+    assert scenario_for(1000) == "mixed" and scenario_for(5000) == LARGE_SCENARIO
+    assert load_scenario(LARGE_SCENARIO).terrain.x_range == (-30.0, 30.0)
