@@ -326,13 +326,14 @@ def lod_scaling_plot(scaling: list[dict], path) -> None:
             r = task["sizes"][n]
             ax.annotate(f"on/off {r['ratio_on_off']:.2f}", (xv, r["on"]["ms_per_frame"]), textcoords="offset points",
                         xytext=(4, -12), fontsize=7, color=MODE_COLOURS["on"])
-    from matplotlib.ticker import NullFormatter, ScalarFormatter
+    from matplotlib.ticker import LogLocator, NullFormatter, ScalarFormatter
 
     ax.set_xscale("log")
     ax.set_yscale("log")
     for axis in (ax.xaxis, ax.yaxis):
         axis.set_major_formatter(ScalarFormatter())
         axis.set_minor_formatter(NullFormatter())
+    ax.yaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
     ax.set_xticks([int(n) for task in scaling for n in task["sizes"]])
     ax.set_xlabel("characters")
     ax.set_ylabel("ms per frame (median, 95 % interval)")
