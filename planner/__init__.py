@@ -5,8 +5,10 @@ numpy + numba only: this package never imports JAX, pyvista or pxr.
 """
 
 from planner._cache import configure_numba_cache as _configure_numba_cache
+from planner._threads import configure_worker_wait as _configure_worker_wait
 
 _configure_numba_cache()
+_configure_worker_wait()
 
 from planner._batch import BatchResult, FootBatch, make_batch, plan_batch  # noqa: E402
 from planner._crowd import ControllerConfig, CrowdModel, CrowdState, init_crowd, planner_config_for, step  # noqa: E402

@@ -26,6 +26,8 @@ from planner._kernels_ik import (
     nearest_in_limits,
     solve_legs_parallel,
     solve_legs_serial,
+    solve_legs_two_bone_parallel,
+    solve_legs_two_bone_serial,
 )
 
 DEFAULT_AZIMUTH_LIMIT = 1.2
@@ -181,7 +183,8 @@ def _leg_statics(rest_azimuths, segment_lengths, limits, azimuth_limits):
 
 def solve_legs(hips, body_rotations, rest_azimuths, segment_lengths, limits, azimuth_limits, targets,
                warm_start=None, max_iterations: int = DEFAULT_MAX_ITERATIONS, tolerance: float = DEFAULT_TOLERANCE,
-               parallel: bool = True, restarts: int = DEFAULT_RESTARTS, pair_steps: bool = True) -> IKResult:
+               parallel: bool = True, restarts: int = DEFAULT_RESTARTS, pair_steps: bool = True,
+               two_bone: bool = False) -> IKResult:
     """CCD inverse kinematics of B legs with S segments, in one kernel call.
 
     hips:            (B, 3) world hip positions (m).
@@ -199,6 +202,10 @@ def solve_legs(hips, body_rotations, rest_azimuths, segment_lengths, limits, azi
     restarts:        grid restarts after a stalled descent (0: a single descent; with a warm
                      start that keeps the pose continuous even when the target is out of reach).
     pair_steps:      add the two-hinge closed-form steps to each sweep (False: plain CCD).
+    two_bone:        the far characters' solve (level of detail): from the warm start (required),
+                     the azimuth and two hinges in closed form, one CCD sweep only where they
+                     cannot reach (:func:`planner._kernels_ik.solve_legs_two_bone_serial`);
+                     ``max_iterations``, ``restarts`` and ``pair_steps`` are not used.
 
     Never raises for an unreachable or degenerate target: the residual says how far the foot
     stays. Raises ValueError naming the offending argument for bad shapes or values.
@@ -222,9 +229,15 @@ def solve_legs(hips, body_rotations, rest_azimuths, segment_lengths, limits, azi
     residual = np.empty(n)
     iterations = np.empty(n, dtype=np.int64)
     joints = np.empty((n, s + 2, 3))
-    kernel = solve_legs_parallel if parallel else solve_legs_serial
-    kernel(hips, rotations, rest, lengths, lim, az, targets, warm, cold, restarts, bool(pair_steps), max_iterations,
-           tol, angles, residual, iterations, joints)
+    if two_bone:
+        if cold:
+            raise ValueError("warm_start: the two-bone solve starts from a pose (got None)")
+        kernel = solve_legs_two_bone_parallel if parallel else solve_legs_two_bone_serial
+        kernel(hips, rotations, rest, lengths, lim, az, targets, warm, tol, angles, residual, iterations, joints)
+    else:
+        kernel = solve_legs_parallel if parallel else solve_legs_serial
+        kernel(hips, rotations, rest, lengths, lim, az, targets, warm, cold, restarts, bool(pair_steps),
+               max_iterations, tol, angles, residual, iterations, joints)
     return IKResult(angles=angles, residual=residual, iterations=iterations, converged=residual < tol,
                     joints=joints)
 

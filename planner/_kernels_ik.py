@@ -627,3 +627,72 @@ def solve_legs_parallel(hips, rotations, rest_azimuths, lengths, limits, azimuth
         _solve_one(b, hips, rotations, rest_azimuths, lengths, limits, azimuth_limits, targets, warm, cold,
                    restarts, pair_steps, max_iterations, tolerance, out_angles, out_residual, out_iterations,
                    out_joints)
+
+
+@nb.njit(cache=True)
+def two_bone_pair(n_seg):
+    """(i, j): the hinges the two-bone solve moves (the two longest bones of the built-in legs: the
+    femur and the tibia of a four-segment leg, the first two hinges of a shorter one)."""
+    i = max(0, n_seg - 3)
+    return i, i + 1
+
+
+@nb.njit(cache=True)
+def _two_bone_one(b, hips, rotations, rest_azimuths, lengths, limits, azimuth_limits, targets, warm, tolerance,
+                  out_angles, out_residual, out_iterations, out_joints):
+    """The analytic solve of leg ``b`` (:func:`solve_legs_two_bone_serial`); writes row ``b``."""
+    n_seg = lengths.shape[1]
+    q = out_angles
+    ex = targets[b, 0] - hips[b, 0]
+    ey = targets[b, 1] - hips[b, 1]
+    ez = targets[b, 2] - hips[b, 2]
+    df = rotations[b, 0, 0] * ex + rotations[b, 1, 0] * ey + rotations[b, 2, 0] * ez
+    du = rotations[b, 0, 1] * ex + rotations[b, 1, 1] * ey + rotations[b, 2, 1] * ez
+    dl = rotations[b, 0, 2] * ex + rotations[b, 1, 2] * ey + rotations[b, 2, 2] * ez
+    alpha = rest_azimuths[b]
+    q[b, 0] = nearest_in_limits(warm[b, 0], -azimuth_limits[b], azimuth_limits[b])
+    for j in range(n_seg):
+        q[b, j + 1] = nearest_in_limits(warm[b, j + 1], limits[b, j, 0], limits[b, j, 1])
+    chain = np.empty((n_seg + 1, N_CHAIN), dtype=np.float64)
+    _chain_from(b, lengths, q, 0, chain)
+    fx = chain[n_seg, CH_X]
+    fy = chain[n_seg, CH_Y]
+    q[b, 0] = _azimuth_for(fx, q[b, 0], df, dl, alpha, azimuth_limits[b])
+    tx, ty, tn = _in_plane_target(df, du, dl, alpha + q[b, 0])
+    i, j = two_bone_pair(n_seg)
+    _, fx, fy = _pair_step(b, i, j, lengths, limits, q, fx, fy, tx, ty, False, chain)
+    residual = math.sqrt((fx - tx) ** 2 + (fy - ty) ** 2 + tn * tn)
+    used = 1
+    if residual >= tolerance:
+        # the two bones alone cannot reach (a limit, a target beyond their span): one CCD sweep of
+        # the whole leg from there, no restart (the pose stays on its branch)
+        residual, sweeps, _ = _descend(b, lengths, limits, azimuth_limits, df, du, dl, alpha, True, False, 1,
+                                       tolerance, False, q, chain)
+        used += sweeps
+    out_residual[b] = residual
+    out_iterations[b] = used
+    _joints_into(b, hips, rotations, rest_azimuths, lengths, q, out_joints)
+
+
+@nb.njit(cache=True)
+def solve_legs_two_bone_serial(hips, rotations, rest_azimuths, lengths, limits, azimuth_limits, targets, warm,
+                               tolerance, out_angles, out_residual, out_iterations, out_joints):
+    """The far characters' IK (level of detail): from the warm start, the azimuth and then the two
+    hinges of :func:`two_bone_pair` in closed form (:func:`_pair_step`, the bend kept: no flip),
+    the other hinges rigid; one CCD sweep of the whole leg only when that leaves the foot beyond
+    ``tolerance`` (a joint limit). Exact wherever the two bones reach, at a few trigonometric
+    calls per leg instead of a CCD sweep's dozens. Arguments and outputs as
+    :func:`solve_legs_serial` (warm starts only)."""
+    for b in range(hips.shape[0]):
+        _two_bone_one(b, hips, rotations, rest_azimuths, lengths, limits, azimuth_limits, targets, warm, tolerance,
+                      out_angles, out_residual, out_iterations, out_joints)
+
+
+@nb.njit(cache=True, parallel=True)
+def solve_legs_two_bone_parallel(hips, rotations, rest_azimuths, lengths, limits, azimuth_limits, targets, warm,
+                                 tolerance, out_angles, out_residual, out_iterations, out_joints):
+    """Same as :func:`solve_legs_two_bone_serial`, legs spread over the cores (bit-identical results)."""
+    for i in nb.prange(hips.shape[0]):
+        b = np.int64(i)
+        _two_bone_one(b, hips, rotations, rest_azimuths, lengths, limits, azimuth_limits, targets, warm, tolerance,
+                      out_angles, out_residual, out_iterations, out_joints)

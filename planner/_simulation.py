@@ -71,6 +71,9 @@ class SimulationSummary:
     there, so it can be 100x a steady frame; ``ms_per_frame_mean`` includes it."""
     ms_per_frame_steady: float | None = None
     """Mean ms of the frames after the first: the steady-state cost (None for a one-frame run)."""
+    lod_levels: dict | None = None
+    """With a LOD mode: the quality of each level of detail (planner._lod_quality), ``pop_max_m``
+    (the largest jump of a rendered foot at a level switch) and ``switches``; None with LOD off."""
 
     def to_json(self) -> dict:
         return asdict(self)
@@ -157,6 +160,7 @@ class StrideMeter:
         self.last_pelvis = np.zeros((c, l, 2))
         self.last_speed = np.zeros((c, l))
         self.errors: list[np.ndarray] = []
+        self.levels: list[np.ndarray] = []  # the LOD level of each measured stride's character at its landing
 
     def update(self, k: int, state: CrowdState, landed: np.ndarray) -> None:
         from planner._timing import stride_frequency
@@ -179,10 +183,18 @@ class StrideMeter:
             if steady.any():
                 f = stride_frequency(self.model.timing, v[steady], self.model.leg_height)
                 self.errors.append(np.abs(stride[steady] * f / v[steady] - 1.0))
+                if state.lod_level is not None:
+                    self.levels.append(state.lod_level[a][steady])
         self.last_frame[cs, ls] = k
         self.last_foot[cs, ls] = foot
         self.last_pelvis[cs, ls] = pelvis
         self.last_speed[cs, ls] = speed
+
+    def by_level(self) -> tuple[np.ndarray, np.ndarray]:
+        """(errors (n,), their characters' LOD levels (n,)) of every measured stride."""
+        if not self.errors:
+            return np.zeros(0), np.zeros(0, np.int8)
+        return np.concatenate(self.errors), np.concatenate(self.levels)
 
     def summary(self) -> tuple[float | None, float | None, int]:
         if not self.errors:
@@ -219,6 +231,11 @@ def simulate(model: CrowdModel, state: CrowdState, frames: int, recorder: Record
     prev_stance = state.in_stance.copy()
     finite = True
     strides = StrideMeter(model, state)
+    levels = None
+    if model.lod_mode != "off":
+        from planner._lod_quality import LevelMeter
+
+        levels = LevelMeter(model, state)
     n_chars = state.pelvis.shape[0]
     travelled = np.zeros(n_chars)
     walking_frames = np.zeros(n_chars)
@@ -244,6 +261,8 @@ def simulate(model: CrowdModel, state: CrowdState, frames: int, recorder: Record
         frame_ms[k] = 1e3 * sum(timings.values())
         # -- metrics (not timed), on the rendered pose (planner._counters) --
         counters.update(state)
+        if levels is not None:
+            levels.update(state)
         prev_stance[:] = state.in_stance
         finite = finite and bool(np.isfinite(state.pelvis).all() and np.isfinite(state.feet).all()
                                  and np.isfinite(state.angles).all())
@@ -269,4 +288,5 @@ def simulate(model: CrowdModel, state: CrowdState, frames: int, recorder: Record
         stuck_seconds=counters.stuck_seconds, unavoidable_contacts=counters.unavoidable_contacts,
         ms_per_frame_warmup=float(frame_ms[0]) if frames else None,
         ms_per_frame_steady=float(np.mean(frame_ms[1:])) if frames > 1 else None,
+        lod_levels=levels.summary(*strides.by_level()) if levels is not None else None,
         gait_fractions={name: float(n / max(gait_frames.sum(), 1)) for name, n in zip(model.schedule.names, gait_frames)})

@@ -91,7 +91,7 @@ SUMMARY_COLUMNS = [
     ("paired_loss_pct", "% of the exhaustive couple score lost, all budgets on the same requests", "loss %"),
     ("score_loss_pct", "% of the exhaustive couple score lost in the setting's own runs", "own loss %"),
     ("plan_us_per_foot", "µs per foot plan (own runs, one core)", "µs / foot plan"),
-    ("ms_per_character", "ms per character per frame (median frame)", "ms / character"),
+    ("paired_cost_ci", "95 % interval of the cost (over the batches planned by every budget)", "cost 95 % CI"),
     ("collisions", "feet in boxes (feet x frames)", "collisions"),
     ("leg_crossings", "crossing leg pairs (x frames)", "leg crossings"),
     ("stride_error_median", "median |stride - target| / target", "stride error"),
@@ -106,7 +106,7 @@ TASK_COLUMNS = [(n, "") for n in ("scenario", "seed", "setting", "characters", "
 
 
 def write_index(path, *, analysis: dict, results: list[dict], meta: dict, scenes: list[dict],
-                recording: dict | None) -> None:
+                recording: dict | None, lod: dict | None = None) -> None:
     """Write ``index.html``. ``scenes``: per scenario, the relative image paths and render status."""
     rows = analysis["rows"]
     rec = next((r for r in rows if r["recommended"]), None)
@@ -127,10 +127,17 @@ def write_index(path, *, analysis: dict, results: list[dict], meta: dict, scenes
             f"{_fmt(rec['slice_size_m'])} m): {rec['paired_cost_vs_first_valid']:.3f} x the first valid couple's "
             f"planning time ({rec['paired_us_per_foot']:.1f} µs per foot plan), "
             f"{rec['paired_loss_pct']:.3f} % of the exhaustive couple score lost (every budget planning the same "
-            "requests).<br>Rule: among the fixed budgets, the cheapest (planning time relative to the first valid "
-            "couple's) whose score loss is at most "
-            f"{analysis['tolerance_pct']} percentage points above the smallest loss of any budget; it is always on the "
-            "Pareto front.</div>")
+            "requests).<br>Rule: among the fixed budgets whose score loss is at most "
+            f"{analysis['tolerance_pct']} percentage points above the smallest loss of any budget, the cheapest "
+            "(planning time relative to the first valid couple's), where cheaper means by more than the noise: the "
+            "budgets whose 95 % cost interval overlaps the cheapest one's count as just as cheap, and of those the one "
+            "losing least is recommended.</div>")
+    far = analysis.get("far_level")
+    if far is not None and far.get("paired_cost_vs_first_valid") is not None:
+        parts.append(f"<p>The far level of detail's planning on the same requests: {far['paired_cost_vs_first_valid']:.3f} "
+                     f"x the first valid couple's time (95 % {_fmt(far['paired_cost_ci_low'])}-"
+                     f"{_fmt(far['paired_cost_ci_high'])}), {far['paired_loss_pct']:.3f} % of the exhaustive couple "
+                     "score lost (<code>planner._far_planning</code>).</p>")
     parts.append("<h2>Quality vs cost</h2>"
                  "<p>Cost: the planning time per foot relative to the first valid couple's on the same requests "
                  "(timed alternately on one core, so the load of other programs cancels out) and in µs, the crowd's "
@@ -166,6 +173,8 @@ def write_index(path, *, analysis: dict, results: list[dict], meta: dict, scenes
                  "characters and turns moving footprints off their preferred points. At low speeds the gait keeps a "
                  "minimum stride frequency, so strides are shorter than the target there by design.</p>")
     parts.append(_img("stride.png", "stride length vs speed"))
+    if lod is not None:
+        parts.extend(lod_section(lod))
     for s in scenes:
         parts.append(f"<h2>Scenario {html.escape(s['scenario'])}</h2>")
         parts.append(f"<p>{html.escape(s['caption'])}</p><div class='pair'>")
@@ -193,3 +202,33 @@ def write_index(path, *, analysis: dict, results: list[dict], meta: dict, scenes
     parts.append(f"</details><p>Score-loss tolerance of the rule: {LOSS_TOLERANCE_PCT} points.</p></body></html>")
     with open(path, "w", encoding="utf-8") as fh:
         fh.write("\n".join(parts))
+
+
+def lod_section(lod: dict) -> list[str]:
+    """The level-of-detail section: cost against crowd size, and quality per level (issue 15)."""
+    from reports._lod_report import LEVEL_TABLE
+
+    parts = ["<h2>Level of detail: cost and quality per level</h2>"]
+    if lod["scaling"]:
+        ratios = {}
+        for r in lod["scaling"]:
+            ratios[r["scenario"], r["characters"]] = (r["ratio_on_off"], r["ratio_ci_low"], r["ratio_ci_high"])
+        said = "; ".join(f"{n} characters on {sc}: {v[0]:.2f} (95 % {v[1]:.2f}-{v[2]:.2f})"
+                         for (sc, n), v in sorted(ratios.items(), key=lambda kv: (kv[0][0], kv[0][1])))
+        parts.append("<p>Cost: one crowd per LOD mode, the three stepped in turns (a frame each, the order rotating), "
+                     "so they share whatever load the machine has; the median ms per frame with the 95 % interval of "
+                     f"that median. LOD on / LOD off: {html.escape(said)} (bootstrap over the rounds). A far character "
+                     "(on screen beyond LodConfig.far_m) plans on compact maps, first near its preferred footprint, and "
+                     "solves its legs in closed form; an off-screen one plans the same way and has no IK "
+                     "(<code>planner._lod</code>). Data: <a href='lod_scaling.csv'>lod_scaling.csv</a>.</p>")
+        parts.append(_img("lod_scaling.png", "ms per frame against crowd size per LOD mode"))
+    if lod["levels"]:
+        parts.append("<p>Quality per level, measured on what is rendered in the sweep's LOD runs: each "
+                     "character-frame counts at the level its character had then; the couple-score loss is that of "
+                     "the level's plans against the exhaustive search on the same requests (the far plans put back on "
+                     "the paper's maps). A pop is the largest move of a rendered foot beyond its planned foot's in a "
+                     "frame where its character switched level. Hover a column name for its meaning; every column "
+                     "(strides measured, jumps without a switch, switches, runs) is in "
+                     "<a href='lod_levels.csv'>lod_levels.csv</a>.</p>")
+        parts.append(_table(lod["levels"], [(name, unit) for name, unit in LEVEL_TABLE]))
+    return parts

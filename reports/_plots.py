@@ -4,7 +4,8 @@
   the recommended budget;
 * :func:`stride_plot`: realised stride length vs speed against lambda = 2.3 h Fr^0.3;
 * :func:`gait_disks`: the gait manager's disks (paper Fig. 8);
-* :func:`footprint_heatmap`: candidate footprints and trajectories of one plan (paper Fig. 13).
+* :func:`footprint_heatmap`: candidate footprints and trajectories of one plan (paper Fig. 13);
+* :func:`lod_scaling_plot`: ms per frame against crowd size per LOD mode, with 95 % intervals.
 """
 
 from __future__ import annotations
@@ -32,8 +33,20 @@ def pareto_plot(analysis: dict, path) -> None:
     cost, loss = analysis["cost_axis"], analysis["loss_axis"]
     budgets = [r for r in rows if r["kind"] == "budget" and r[cost] is not None]
     lods = [r for r in rows if r["kind"] == "lod"]
-    ax.scatter([r[cost] for r in budgets], [r[loss] for r in budgets], c="#4c72b0",
-               label="fixed budget (all on the same requests)", zorder=3)
+    def xerr(rs):
+        return [[r[cost] - (r.get("paired_cost_ci_low") if r.get("paired_cost_ci_low") is not None else r[cost])
+                 for r in rs],
+                [(r.get("paired_cost_ci_high") if r.get("paired_cost_ci_high") is not None else r[cost]) - r[cost]
+                 for r in rs]]
+
+    ax.errorbar([r[cost] for r in budgets], [r[loss] for r in budgets], xerr=xerr(budgets), fmt="o", c="#4c72b0",
+                capsize=3, label="fixed budget, 95 % interval of its cost (all on the same requests)", zorder=3)
+    far = analysis.get("far_level")
+    if far is not None and far[cost] is not None:
+        ax.errorbar([far[cost]], [far[loss]], xerr=xerr([far]), fmt="D", c="#8172b2", capsize=3, zorder=3,
+                    label="far level of detail's planning (same requests)")
+        ax.annotate("LOD far", (far[cost], far[loss]), textcoords="offset points", xytext=(4, 4), fontsize=7,
+                    color="#8172b2")
     for r in budgets:
         ax.annotate(r["setting"].removeprefix("budget-"), (r[cost], r[loss]),
                     textcoords="offset points", xytext=(4, 4), fontsize=7)
@@ -51,6 +64,9 @@ def pareto_plot(analysis: dict, path) -> None:
     if rec is not None:
         ax.scatter([rec[cost]], [rec[loss]], marker="*", s=260, c="#c44e52",
                    edgecolors="k", zorder=4, label=f"recommended: {rec['setting']}")
+    # The whole range from no work: the differences between budgets are read against the noise bars,
+    # not against an axis zoomed onto them.
+    ax.set_xlim(left=0.0)
     ax.set_xlabel("cost: time per foot plan / the first valid couple's (same requests, interleaved)")
     ax.set_ylabel("quality loss: % of the exhaustive couple score")
     ax.set_title("Search budget: quality vs cost")
@@ -285,3 +301,43 @@ def _scalar_mappable(norm=None):
     from matplotlib.colors import Normalize
 
     return ScalarMappable(norm=norm or Normalize(0.0, 1.0), cmap=SCORE_COLOURS)
+
+
+MODE_COLOURS = {"on": "#4c72b0", "zoomed": "#55a868", "off": "#c44e52"}
+
+
+def lod_scaling_plot(scaling: list[dict], path) -> None:
+    """Median ms per frame against crowd size (log-log), one line per LOD mode and scenario, the
+    bars the 95 % interval of each median (the modes stepped in turns: the same load for all)."""
+    fig = Figure(figsize=(7.5, 4.6), layout="constrained")
+    ax = fig.subplots()
+    styles = ("-", "--", ":", "-.")
+    for k, task in enumerate(scaling):
+        sizes = sorted(task["sizes"], key=int)
+        x = np.array([int(n) for n in sizes], dtype=np.float64)
+        for mode in ("on", "zoomed", "off"):
+            rows = [task["sizes"][n][mode] for n in sizes]
+            y = np.array([r["ms_per_frame"] for r in rows])
+            lo = np.array([r["ms_per_frame_ci"][0] for r in rows])
+            hi = np.array([r["ms_per_frame_ci"][1] for r in rows])
+            ax.errorbar(x, y, yerr=[y - lo, hi - y], marker="o", ms=4, capsize=3, ls=styles[k % len(styles)],
+                        c=MODE_COLOURS[mode], label=f"LOD {mode}" + (f", {task['scenario']}" if len(scaling) > 1 else ""))
+        for n, xv in zip(sizes, x):
+            r = task["sizes"][n]
+            ax.annotate(f"on/off {r['ratio_on_off']:.2f}", (xv, r["on"]["ms_per_frame"]), textcoords="offset points",
+                        xytext=(4, -12), fontsize=7, color=MODE_COLOURS["on"])
+    from matplotlib.ticker import LogLocator, NullFormatter, ScalarFormatter
+
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    for axis in (ax.xaxis, ax.yaxis):
+        axis.set_major_formatter(ScalarFormatter())
+        axis.set_minor_formatter(NullFormatter())
+    ax.yaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+    ax.set_xticks([int(n) for task in scaling for n in task["sizes"]])
+    ax.set_xlabel("characters")
+    ax.set_ylabel("ms per frame (median, 95 % interval)")
+    ax.set_title("Cost of a frame against crowd size, per LOD mode (modes stepped in turns)")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=8)
+    _save(fig, path)

@@ -19,7 +19,7 @@ from pathlib import Path
 from footfall._atomic import make_folder
 from footfall._errors import InputError
 from footfall._distribute import check_workers, run_tasks
-from reports import _html, _pareto, _plots, _sweep
+from reports import _html, _lod_report, _pareto, _plots, _sweep
 
 REPORT_FORMAT = "footfall-report"
 REPORT_VERSION = 1
@@ -175,7 +175,11 @@ def build_report(out, *, preset: str = "default", scenarios: tuple[str, ...] | N
             done += len(tasks)
             analysis = _pareto.analyse(results)
             _plots.pareto_plot(analysis, tmp / "pareto.png")
-            runs = [r for r in results if r["kind"] != "paired"]
+            runs = [r for r in results if r["kind"] not in ("paired", "lod-scaling")]
+            scaling = [r for r in results if r["kind"] == "lod-scaling"]
+            lod = _lod_report.analyse(runs, scaling)
+            if scaling:
+                _plots.lod_scaling_plot(scaling, tmp / "lod_scaling.png")
             _plots.stride_plot(runs, tmp / "stride.png")
             scenes = []
             scene_notes = []
@@ -232,19 +236,24 @@ def build_report(out, *, preset: str = "default", scenarios: tuple[str, ...] | N
                     "wall_seconds": time.perf_counter() - t_start}
             _write_csv(tmp / "results.csv", runs, task_columns(runs))
             paired_rows = [{"scenario": r["scenario"], "seed": r["seed"], "characters": r["characters"],
-                            "situations": r["situations"], **b} for r in results if r["kind"] == "paired"
+                            "situations": r["situations"], **{k: v for k, v in b.items() if k != "cost_ratios"}}
+                           for r in results if r["kind"] == "paired"
                            for b in r["budgets"]]
             if paired_rows:
                 _write_csv(tmp / "paired.csv", paired_rows, list(paired_rows[0]))
             summary_columns = ([n for n, _, _ in _pareto.COLUMNS] + [n for n, _ in _pareto.PAIRED_COLUMNS]
                                + ["on_front", "recommended"])
             _write_csv(tmp / "summary.csv", analysis["rows"], summary_columns)
-            summary = {**meta, "recommended_budget": analysis["recommended_budget"], "front": analysis["front"],
+            if lod["levels"]:
+                _write_csv(tmp / "lod_levels.csv", lod["levels"], list(lod["levels"][0]))
+            if lod["scaling"]:
+                _write_csv(tmp / "lod_scaling.csv", lod["scaling"], list(lod["scaling"][0]))
+            summary = {**meta, "lod": lod, "recommended_budget": analysis["recommended_budget"], "front": analysis["front"],
                        "tolerance_pct": analysis["tolerance_pct"], "rows": analysis["rows"],
                        "scenes": scene_notes, "render_errors": render_errors}
             (tmp / "results.json").write_text(json.dumps({**summary, "tasks": results}, indent=1))
             _html.write_index(tmp / "index.html", analysis=analysis, results=runs, meta=meta, scenes=scenes,
-                              recording=rec_page)
+                              recording=rec_page, lod=lod)
         _publish(tmp, out)
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)

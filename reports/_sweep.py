@@ -92,6 +92,11 @@ class SweepOptions:
     warmup: int = 30
     scene_characters: int = 6
     scene_frames: int = 120
+    # Crowd sizes run with the LOD modes only (``lod-on``, ``lod-zoomed``, ``lod-off`` among the
+    # settings): crowds large enough that the camera puts characters at the far level of detail
+    # (beyond LodConfig.far_m), for the quality of every level; and the sizes of the LOD scaling task
+    # (ms per frame against crowd size, the three modes stepped in turns, :func:`run_lod_scaling`).
+    lod_sizes: tuple[int, ...] = ()
 
 
 # c0 with slices decides as c0 without (the first slice, "go over", is searched first), so it is left out.
@@ -104,20 +109,23 @@ PRESETS = {
     # The tests: seconds.
     "quick": SweepOptions(scenarios=("mixed",), settings=("lod-on", "lod-off", setting_name(0, None),
                                                           setting_name(2, 0.10), setting_name(None, 0.10)),
-                          sizes=(4,), frames=30, warmup=10, scene_characters=3, scene_frames=45),
+                          sizes=(4,), frames=30, warmup=10, scene_characters=3, scene_frames=45, lod_sizes=(24,)),
     # The main job: about two minutes on two cores.
     "default": SweepOptions(scenarios=("mixed", "crates"), settings=LOD_SETTINGS + _BUDGETS_DEFAULT,
-                            sizes=(8, 32), frames=50, warmup=15, scene_characters=6, scene_frames=90),
+                            sizes=(8, 32), frames=50, warmup=15, scene_characters=6, scene_frames=90,
+                            lod_sizes=(150,)),
     # Everything: every built-in scenario, 21 budgets, up to 100 characters (about an hour on two cores).
     "full": SweepOptions(scenarios=("flat", "hills", "stairs", "crates", "crates-moving", "mixed"),
                          settings=LOD_SETTINGS + _BUDGETS_FULL, sizes=(10, 50, 100), frames=240, warmup=60,
-                         scene_characters=10, scene_frames=240),
+                         scene_characters=10, scene_frames=240, lod_sizes=(300, 1000)),
 }
 
 
 TIMING_KEYS = frozenset({"ms_per_frame", "ms_per_character", "plan_ms_per_frame", "ik_ms_per_frame",
                          "plan_us_per_foot", "wall_seconds", "plan_cost_vs_first_valid", "us_per_foot",
-                         "cost_vs_first_valid"})
+                         "cost_vs_first_valid", "cost_ratios",
+                         # the LOD scaling task (benchmarks.crowd_bench)
+                         "ms_per_frame_ci", "maps_ms", "plan_ms", "ik_ms", "fps", "ratio_on_off", "ratio_on_off_ci"})
 """Result fields measured with a clock: they move with the load of the machine; every other
 field of a task's result depends only on the task (same task, same numbers, on any worker)."""
 
@@ -146,6 +154,17 @@ def build_tasks(options: SweepOptions) -> list[dict]:
                 if budgets:
                     tasks.append({**common, **parse_setting("lod-off"), "kind": "paired", "setting": "paired",
                                   "budgets": [parse_setting(n)["setting"] for n in budgets]})
+            lods = [n for n in options.settings if parse_setting(n)["kind"] == "lod"]
+            for size in options.lod_sizes:
+                common = {"scenario": scenario, "seed": int(seed), "characters": int(size),
+                          "frames": int(options.frames), "warmup": int(options.warmup)}
+                for name in lods:
+                    tasks.append({**common, **parse_setting(name)})
+            if lods and options.lod_sizes:
+                sizes = sorted(set(options.sizes) | set(options.lod_sizes))
+                tasks.append({"scenario": scenario, "seed": int(seed), "kind": "lod-scaling", "setting": "lod-scaling",
+                              "characters": max(sizes), "sizes": sizes,
+                              "frames": int(options.frames), "warmup": int(options.warmup)})
     return tasks
 
 
@@ -187,6 +206,7 @@ class PlanTap:
         self.exhaustive_scores = []
         self.budget_valid = []
         self.exhaustive_valid = []
+        self.levels = []  # the LOD level of each compared plan's character
         self.curvature = []
         self.timed_seconds = 0.0
         self.ref_seconds = 0.0
@@ -194,15 +214,33 @@ class PlanTap:
         self.sample = None  # (batch, result, foot index, weights, config, interest) for the Fig. 13 heatmap
 
     def record(self, model, state) -> None:
-        """After a frame: keep the frame's planning call (if it planned) for the next flush."""
-        if self.capture and state.last_batch is not None:
-            self.pending.append((state.last_batch, state.last_plans[3], model.weights, model.config))
+        """After a frame: keep the frame's planning calls (if it planned) for the next flush.
+
+        With a LOD mode a frame may plan in several calls (the far characters' on compact maps,
+        ``planner._far_planning``); their requests are put back on the paper's 70 x 70 maps (built
+        here, outside the frame timings) so that the exhaustive reference of every plan is the same
+        search on the same maps, whatever the level of detail that planned it. Each plan keeps its
+        character's level (``self.levels``)."""
+        if not self.capture or state.last_plans is None:
+            return
+        cs, _, _, out = state.last_plans
+        if state.last_batch is not None and len(state.last_groups) <= 1:
+            self.pending.append((state.last_batch, out, model.weights, model.config, state.lod_level[cs]))
+            return
+        from planner._crowd import _boxes_now, stage_maps
+
+        for batch, config, rows, chars in state.last_groups:
+            if config is not model.config:
+                elev, ground, forb, origin = stage_maps(model, state, chars, _boxes_now(model, state.t), count=False)
+                batch = dataclasses.replace(batch, elevation=elev, ground=ground, forbidden=forb, origins=origin)
+            self.pending.append((batch, _take_result(out, rows), model.weights, model.config,
+                                 state.lod_level[cs[rows]]))
 
     def flush(self) -> None:
         """Exhaustive scores, timed re-plans and curvature of the plans since the last flush."""
         from planner import EXHAUSTIVE, FIRST_VALID
 
-        for batch, out, weights, config in self.pending:
+        for batch, out, weights, config, levels in self.pending:
             self.calls += 1
             if (self.keep_every and self.calls % self.keep_every == 0
                     and sum(b.n_feet for b, _, _ in self.kept) < self.keep_feet):
@@ -215,6 +253,7 @@ class PlanTap:
             self.exhaustive_scores.append(exhaustive.scores[:, 0].copy())
             self.budget_valid.append(out.valid.copy())
             self.exhaustive_valid.append(exhaustive.valid.copy())
+            self.levels.append(np.asarray(levels).copy())
             if self.calls % OWN_TIMING_EVERY == 0:
                 # Timed beside the first valid couple on the same requests, alternating: the ratio of the
                 # two stands still when other programs load the machine, the microseconds do not.
@@ -235,15 +274,44 @@ class PlanTap:
         self.pending.clear()
 
 
+def _take_result(out, rows):
+    """The BatchResult of the requests ``rows`` of ``out``."""
+    return type(out)(**{name: getattr(out, name)[rows] for name in type(out).__dataclass_fields__})
+
+
 def _time_interleaved(batches, weights, config, rounds: int = TIMING_REPEATS) -> np.ndarray:
     """Seconds to plan each batch on one core: best of ``rounds``, the order rotating each round."""
-    best = np.full(len(batches), np.inf)
+    return _time_calls([functools.partial(plan_batch, b, weights, config, "search", False) for b in batches], rounds)
+
+
+def _time_calls(calls, rounds: int = TIMING_REPEATS) -> np.ndarray:
+    """Seconds of each call: best of ``rounds``, the order rotating each round."""
+    best = np.full(len(calls), np.inf)
     for r in range(rounds):
-        for j in np.roll(np.arange(len(batches)), r):
+        for j in np.roll(np.arange(len(calls)), r):
             t0 = time.perf_counter()
-            plan_batch(batches[j], weights, config, "search", False)
+            calls[j]()
             best[j] = min(best[j], time.perf_counter() - t0)
     return best
+
+
+def plan_far(batch, weights, first, fallback):
+    """A far character's planning (``planner._far_planning``) of ``batch`` on one core: the first
+    try near the preferred footprints, the full first-valid search for the feet it left without a
+    couple. Returns the BatchResult of every foot."""
+    from planner._crowd import _merge_results, _take_requests
+    from planner._params import FIRST_VALID
+
+    batch = with_budget(batch, *FIRST_VALID.kernel_args())
+    out = plan_batch(batch, weights, first, "search", False)
+    missed = np.flatnonzero(~out.valid)
+    if missed.size == 0:
+        return out
+    retry = dataclasses.replace(_take_requests(batch, missed), elevation=batch.elevation, ground=batch.ground,
+                                forbidden=batch.forbidden, origins=batch.origins, foot_char=batch.foot_char[missed])
+    again = plan_batch(retry, weights, fallback, "search", False)
+    return _merge_results([(np.flatnonzero(out.valid), _take_result(out, np.flatnonzero(out.valid))),
+                           (missed, again)], batch.n_feet)
 
 
 # --------------------------------------------------------------------------- metrics
@@ -337,7 +405,12 @@ def _run_crowd(task: dict, recorder_frames: bool = True, keep_every: int = 0, ke
 def run_task(task: dict) -> dict:
     """Metrics of one task (plain numbers and lists; JSON-ready)."""
     t0 = time.perf_counter()
-    result = run_paired(task) if task["kind"] == "paired" else _run_setting(task)
+    if task["kind"] == "paired":
+        result = run_paired(task)
+    elif task["kind"] == "lod-scaling":
+        result = run_lod_scaling(task)
+    else:
+        result = _run_setting(task)
     result["wall_seconds"] = time.perf_counter() - t0
     return result
 
@@ -351,6 +424,7 @@ def _run_setting(task: dict) -> dict:
     ev = np.concatenate(tap.exhaustive_valid) if tap.exhaustive_valid else np.zeros(0, bool)
     # A situation the exhaustive search solves counts; a budget that found nothing there lost the whole score.
     deficit = np.where(bv[ev], e[ev] - b[ev], e[ev])
+    lv = np.concatenate(tap.levels)[ev] if tap.levels else np.zeros(0, np.int8)
     a = recorder.arrays
     speeds, strides = realised_strides(a["feet"], a["in_stance"], a["pelvis"], model.dt)
     walking = speeds > STRIDE_MIN_SPEED
@@ -384,6 +458,7 @@ def _run_setting(task: dict) -> dict:
         "missed_plans": int((ev & ~bv).sum()),
         "collisions": summary.collisions, "forbidden_footprints": summary.forbidden_footprints,
         "leg_crossings": summary.leg_crossings, "holds": summary.holds, "steps": summary.steps,
+        "body_overlaps": summary.body_overlaps,
         "strides": int(strides.size),
         "stride_error_median": float(np.median(np.abs(error))) if strides.size else None,
         "stride_bias_median": float(np.median(error)) if strides.size else None,
@@ -392,9 +467,44 @@ def _run_setting(task: dict) -> dict:
         "curvature_energy_p95": float(np.percentile(curv, 95)) if curv.size else 0.0,
         "ik_residual_p95_m": summary.ik_residual_p95_m, "max_stance_slip_m": summary.max_stance_slip_m,
         "finite": summary.finite,
+        "lod_levels": _levels_with_loss(summary.lod_levels, e[ev], deficit, lv),
     }
 
 
+def _levels_with_loss(levels: dict | None, exhaustive: np.ndarray, deficit: np.ndarray, level: np.ndarray):
+    """The run's per-level quality (``planner._lod_quality``) with each level's couple-score loss
+    against the exhaustive search (% of the exhaustive score) and how many plans it rests on."""
+    if levels is None:
+        return None
+    from planner._lod import LEVEL_NAMES
+
+    out = {**levels, "levels": {name: dict(row) for name, row in levels["levels"].items()}}
+    for k, name in enumerate(LEVEL_NAMES):
+        if name not in out["levels"]:
+            continue
+        mine = level == k
+        best = float(exhaustive[mine].sum())
+        out["levels"][name]["situations"] = int(mine.sum())
+        out["levels"][name]["score_loss_pct"] = (100.0 * float(deficit[mine].sum()) / best) if best > 0 else None
+    return out
+
+
+def run_lod_scaling(task: dict) -> dict:
+    """ms per frame against crowd size for the three LOD modes (``footfall bench crowd``'s
+    measurement: one crowd per mode, stepped in turns so they share the machine's load; the median
+    frame with its 95 % interval, and LOD on / LOD off with a bootstrap interval)."""
+    from benchmarks.crowd_bench import run
+
+    _, creature, _ = _load_inputs(task["scenario"])
+    sizes = run(sizes=tuple(task["sizes"]), frames=task["frames"], warmup=task["warmup"], seed=task["seed"],
+                scenario_name=task["scenario"], creature_name=creature.name)
+    return {"kind": "lod-scaling", "setting": "lod-scaling", "scenario": task["scenario"], "seed": task["seed"],
+            "sizes": sizes}
+
+
+FAR_LEVEL = "lod-far-planning"
+"""The paired benchmark's row of the far level of detail's planning (``planner._far_planning``:
+first valid couple, first near the preferred footprint), beside the fixed budgets."""
 PAIRED_KEEP_EVERY = 3  # planning calls (frames) between two kept for the paired benchmark
 PAIRED_KEEP_FEET = 800  # bounds the memory of the kept local maps (~100 MB at 100 characters)
 
@@ -419,7 +529,16 @@ def run_paired(task: dict) -> dict:
         from planner import SearchBudget
 
         args.append(SearchBudget(p["couples_after_first"], p["slice_size_m"], paper_early_stop=True).kernel_args())
+    from planner._far_planning import far_configs
+    from planner._lod import LodConfig
+
+    lod = LodConfig()
+    span = model.rest_radius + model.config.search_radius_m + float(np.max(model.reach))
+    first, fallback = far_configs(model.config, span, lod.far_radius_cells, lod.far_margin_cells,
+                                  lod.far_fallback_margin_cells)
+    names = names + [FAR_LEVEL]  # the far level of detail's planning, on the same requests
     seconds = np.zeros(len(names) + 1)  # the last: the first valid couple, the reference of the cost ratios
+    ratios = [[] for _ in names]  # per kept batch: each variant's time / the first valid couple's
     chosen = np.zeros(len(names))
     suboptimal = np.zeros(len(names))
     best_total = 0.0
@@ -431,17 +550,23 @@ def run_paired(task: dict) -> dict:
         best_total += float(exhaustive.scores[ok, 0].sum())
         feet += int(ok.sum())
         variants = [with_budget(batch, *a) for a in args] + [with_budget(batch, *FIRST_VALID.kernel_args())]
-        for j, variant in enumerate(variants[:-1]):
-            out = plan_batch(variant, weights, config, "search", False)
+        calls = [functools.partial(plan_batch, v, weights, config, "search", False) for v in variants]
+        calls.insert(len(args), functools.partial(plan_far, batch, weights, first, fallback))
+        for j, call in enumerate(calls[:-1]):
+            out = call()
             got = np.where(out.valid[ok], out.scores[ok, 0], 0.0)
             chosen[j] += float(got.sum())
             suboptimal[j] += float((exhaustive.scores[ok, 0] - got > 1e-9).sum())
-        seconds += _time_interleaved(variants, weights, config)
+        timed = _time_calls(calls)
+        seconds += timed
+        for j in range(len(names)):
+            ratios[j].append(float(timed[j] / timed[-1]) if timed[-1] > 0 else None)
     all_feet = sum(b.n_feet for b, _, _ in tap.kept)
     rows = []
     for j, name in enumerate(names):
         rows.append({"budget": name, "us_per_foot": float(1e6 * seconds[j] / max(all_feet, 1)),
                      "cost_vs_first_valid": float(seconds[j] / seconds[-1]) if seconds[-1] > 0 else None,
+                     "cost_ratios": [r for r in ratios[j] if r is not None],
                      "score_loss_pct": float(100.0 * (1.0 - chosen[j] / best_total)) if best_total > 0 else 0.0,
                      "suboptimal_fraction": float(suboptimal[j] / max(feet, 1))})
     return {"kind": "paired", "scenario": scenario.name, "seed": task["seed"], "characters": task["characters"],

@@ -250,7 +250,7 @@ def split_variant(spec: str) -> tuple[str, dict[str, Any]]:
     """
     name, _, rest = spec.partition("@")
     overrides: dict[str, Any] = {}
-    for item in filter(None, rest.split(",")):
+    for item in filter(None, _split_outside_brackets(rest)):
         key, eq, value = item.partition("=")
         if not eq or not key.strip():
             raise InputError(spec, "scenario", f"variant {item!r}: expected key=value")
@@ -259,6 +259,19 @@ def split_variant(spec: str) -> tuple[str, dict[str, Any]]:
         except tomllib.TOMLDecodeError:
             raise InputError(spec, "scenario", f"variant {item!r}: {value.strip()!r} is not a TOML value") from None
     return name, overrides
+
+
+def _split_outside_brackets(text: str) -> list[str]:
+    """``text`` split at the commas that are not inside ``[...]`` (a TOML array is one value:
+    ``terrain.size=[60.0,60.0],seed=2`` is two items)."""
+    items, depth, start = [], 0, 0
+    for i, ch in enumerate(text):
+        depth += (ch == "[") - (ch == "]")
+        if ch == "," and depth == 0:
+            items.append(text[start:i])
+            start = i + 1
+    items.append(text[start:])
+    return items
 
 
 def variant_name(name: str, **overrides: Any) -> str:

@@ -1,0 +1,22 @@
+"""How the numba kernels' worker threads wait between two parallel regions.
+
+numba's OpenMP layer (libgomp) lets an idle worker spin on its core for a while after each
+parallel region, by default, so the next region starts without a wake-up. On a machine whose
+cores are all busy (2 cores shared with other programs, issue 15) the spinning workers take the
+cores from the main thread and from each other, and a region then waits for a descheduled
+worker: a frame of 1000 spiders took about 3 x as long (170-230 ms instead of 52-81 ms, the same
+runs with ``OMP_WAIT_POLICY=PASSIVE``, the workqueue layer or a single thread). Passive workers
+sleep at once; on an idle machine that costs a wake-up per region (microseconds). Results do not
+depend on it (every kernel gives the same numbers on any number of threads). Set
+``OMP_WAIT_POLICY`` yourself to override.
+"""
+
+from __future__ import annotations
+
+import os
+
+
+def configure_worker_wait() -> None:
+    """``OMP_WAIT_POLICY=PASSIVE`` unless already set (read when libgomp loads, at the first
+    parallel kernel, so this runs on importing :mod:`planner`)."""
+    os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
