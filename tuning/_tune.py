@@ -331,6 +331,9 @@ def _pad_problem(problem, n: int, k: int, s: int):
         jerk_max=jnp.asarray(pad(problem.jerk_max, 1.0, rows)),
         curvature_max=jnp.asarray(pad(problem.curvature_max, 1.0, rows)),
         clearance_min_m=jnp.asarray(pad(problem.clearance_min_m, 1.0, rows)),
+        slope_max=jnp.asarray(pad(problem.slope_max, np.inf, rows)),
+        detour_max=jnp.asarray(pad(problem.detour_max, np.inf, rows)),
+        curvature_p95_max=jnp.asarray(pad(problem.curvature_p95_max, np.inf, rows)),
         creature_one_hot=jnp.asarray(pad(problem.creature_one_hot, 0.0, rows)))
 
 
