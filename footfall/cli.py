@@ -552,20 +552,36 @@ def _field_values(items: Optional[list[str]], option: str) -> tuple[tuple[str, f
 @app.command("tune")
 def tune_cmd(
     creature: str = typer.Option(..., "--creature", help="Creature to tune: built-in name or .toml"),
+    scenarios: Optional[str] = typer.Option(
+        None, "--scenarios", help="Tune the scoring weights for these terrains, A,B,... (built-in names, files or "
+        "variants such as stairs@terrain.rise=0.1); runs spawn along each route and meet its feature"),
+    targets: Optional[str] = typer.Option(
+        None, "--targets", help="Targets .toml: the stride law, duty-factor bands and a style (tuning/_targets.py "
+        "and tuning/data/styles/ for examples); with it, the weights are tuned (on stairs, crates, hills, mixed "
+        "unless --scenarios says)"),
     out: Optional[str] = typer.Option(None, "--out", help="Preset file (.json; default out/presets/NAME.json); "
                                       "the checkpoint is written beside it"),
     resume: bool = typer.Option(False, "--resume", help="Continue a killed run from its checkpoint"),
-    rounds: int = typer.Option(2, "--rounds", help="Outer rounds at most (harvest, fit, exact loss)"),
+    rounds: Optional[int] = typer.Option(None, "--rounds", help="Outer rounds at most (harvest, fit, exact runs; "
+                                         "default 2, 3 with --scenarios/--targets)"),
     seed: int = typer.Option(0, "--seed", help="Seed of the harvests and runs (same seed, same preset)"),
     start_timing: Optional[list[str]] = typer.Option(
         None, "--start-timing", help="Start the search from a mis-tuned gait timing, FIELD=VALUE of GaitTiming "
         "(repeatable, e.g. stride_coefficient=3.0); the summary adds the *_start figures"),
+    spearman_candidates: int = typer.Option(
+        0, "--spearman-candidates", min=0, help="With --scenarios/--targets: validate the proxies on this many "
+        "candidate presets (>= 20 for the issue's check; costs as many exact evaluations)"),
     cluster: Optional[str] = typer.Option(None, help="Dask scheduler address (tcp://host:8786) to run the harvests "
                                           "and exact runs on"),
     workers: Optional[int] = typer.Option(None, help="Local worker processes (default: one per core; 1: in-process)"),
     json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),
 ) -> None:
-    """Tune a creature's scoring weights and gait timing against the biomechanics targets and write a preset."""
+    """Tune a creature against its targets and write a preset.
+
+    Without --scenarios and --targets: the gait timing against the stride law on a sweep of speeds (the \
+generic preset). With either: the scoring weights for those terrains and that style, on runs that \
+meet the terrain, checked on held-out variants (a terrain or style preset).
+    """
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
     from footfall._distribute import check_workers
@@ -576,14 +592,35 @@ def tune_cmd(
     check_workers(workers, cluster)
     check_creature(creature)
     path = check_output(out or f"out/presets/{load_creature(creature).name}.json")
-    config = TuneConfig(creature, rounds=rounds, seed=seed, start_timing=_field_values(start_timing, "--start-timing"))
+    if rounds is not None and rounds < 1:
+        raise InputError("argument", "--rounds", f"expected an integer >= 1, got {rounds}")
+    events = scenarios is not None or targets is not None
+    if events:
+        from tuning._targets import load_tune_targets
+        from tuning._tune_events import DEFAULT_SCENARIOS, EventTuneConfig, check_scenarios, tune_events
+
+        if start_timing:
+            raise InputError("argument", "--start-timing", "tunes the timing; --scenarios/--targets tune the weights")
+        load_tune_targets(targets, creature)  # a malformed file: one line, before any work
+        names = check_scenarios(scenarios.split(",")) if scenarios is not None else DEFAULT_SCENARIOS
+        config = EventTuneConfig(creature, scenarios=names, targets_file=targets, seed=seed,
+                                 **({} if rounds is None else {"rounds": rounds}))
+    else:
+        config = TuneConfig(creature, rounds=rounds or 2, seed=seed,
+                            start_timing=_field_values(start_timing, "--start-timing"))
     bar = Progress(TextColumn("tune"), BarColumn(), TextColumn("{task.description}"), TimeElapsedColumn(),
                    console=_err(), transient=True, disable=not _err().is_terminal)
     with bar:
         task = bar.add_task("starting", total=config.rounds + 2)
-        result = tune(config, path, resume=resume, workers=workers, cluster=cluster,
-                      progress=lambda what, done, total: bar.update(task, description=what, completed=done,
-                                                                    total=total))
+
+        def said(what, done, total):
+            bar.update(task, description=what, completed=done, total=total)
+
+        if events:
+            result = tune_events(config, path, resume=resume, workers=workers, cluster=cluster, progress=said,
+                                 spearman_candidates=spearman_candidates)
+        else:
+            result = tune(config, path, resume=resume, workers=workers, cluster=cluster, progress=said)
     summary = dict(result.summary, wall_s=result.wall_s, preset=str(path))
     if json_out:
         print(json.dumps(summary))
@@ -592,6 +629,9 @@ def tune_cmd(
     table.add_column("metric")
     table.add_column("value", justify="right")
     for key, value in summary.items():
+        if key == "targets":
+            value = f"{value['file']} (stride law {value['stride_length']['coefficient']:g} h Fr^" \
+                    f"{value['stride_length']['exponent']:g}; style {value['style'] or 'none'})"
         table.add_row(key, f"{value:.4g}" if isinstance(value, float) else str(value))
     _stdout().print(table)
 

@@ -6,6 +6,7 @@ import html
 import math
 
 from reports._pareto import COLUMNS, LOSS_TOLERANCE_PCT, PAIRED_COLUMNS
+from reports._sweep import stride_law_text
 
 STYLE = """
 body { font-family: system-ui, sans-serif; margin: 2em auto; max-width: 1200px; color: #222; }
@@ -141,7 +142,7 @@ def write_index(path, *, analysis: dict, results: list[dict], meta: dict, scenes
                  "Frame timings move with the load of the machine. Quality: the couple-score deficit against the exhaustive search "
                  "(planner.EXHAUSTIVE: no couple limit, 5 cm slices, exact stop) on the same situations, "
                  "collisions, forbidden footprints, leg crossings, stride length error against "
-                 "λ = 2.3 h Fr<sup>0.3</sup>, curvature energy E = l ∫κ² ds of the swing paths (horizontal, "
+                 f"λ = {stride_law_text('spider', html=True)} (tuning/data/targets.toml), curvature energy E = l ∫κ² ds of the swing paths (horizontal, "
                  "u in [0.05, 0.95]) and the IK residual. Blue rows: on the budgets' Pareto front; yellow: recommended. "
                  "Hover a column name for its unit. The short table below has the figures that decide; "
                  "<i>All columns</i> opens the full one.</p>")
