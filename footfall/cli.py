@@ -568,6 +568,9 @@ def tune_cmd(
     start_timing: Optional[list[str]] = typer.Option(
         None, "--start-timing", help="Start the search from a mis-tuned gait timing, FIELD=VALUE of GaitTiming "
         "(repeatable, e.g. stride_coefficient=3.0); the summary adds the *_start figures"),
+    characters: int = typer.Option(1, "--characters", min=1, help="With --scenarios/--targets: characters per run"),
+    frames: int = typer.Option(300, "--frames", min=60, help="With --scenarios/--targets: frames per run (each "
+                               "scenario is run from spawns along its route)"),
     spearman_candidates: int = typer.Option(
         0, "--spearman-candidates", min=0, help="With --scenarios/--targets: validate the proxies on this many "
         "candidate presets (>= 20 for the issue's check; costs as many exact evaluations)"),
@@ -603,8 +606,8 @@ meet the terrain, checked on held-out variants (a terrain or style preset).
             raise InputError("argument", "--start-timing", "tunes the timing; --scenarios/--targets tune the weights")
         load_tune_targets(targets, creature)  # a malformed file: one line, before any work
         names = check_scenarios(scenarios.split(",")) if scenarios is not None else DEFAULT_SCENARIOS
-        config = EventTuneConfig(creature, scenarios=names, targets_file=targets, seed=seed,
-                                 **({} if rounds is None else {"rounds": rounds}))
+        config = EventTuneConfig(creature, scenarios=names, targets_file=targets, seed=seed, characters=characters,
+                                 frames=frames, **({} if rounds is None else {"rounds": rounds}))
     else:
         config = TuneConfig(creature, rounds=rounds or 2, seed=seed,
                             start_timing=_field_values(start_timing, "--start-timing"))
@@ -686,6 +689,71 @@ def bench_tuning_cmd(
         print(json.dumps(result))
         return
     _stdout().print(table(result))
+
+
+@bench_app.command("presets")
+def bench_presets_cmd(
+    presets_dir: str = typer.Option("tuning/data/presets", "--presets-dir", help="Folder of the presets NAME.json"),
+    names: Optional[str] = typer.Option(None, "--presets", help="Presets to prove, A,B,... (default: every terrain "
+                                        "and style preset of tuning._matrix.PRESETS)"),
+    runs: int = typer.Option(30, "--runs", min=2, help="Paired runs per preset x terrain cell"),
+    out: Optional[str] = typer.Option(None, "--out", help="Write the matrix here (.json), e.g. tuning/data/matrix.json"),
+    cluster: Optional[str] = typer.Option(None, help="Dask scheduler address to run the runs on"),
+    workers: Optional[int] = typer.Option(None, help="Local worker processes (default: one per core; 1: in-process)"),
+    json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),
+) -> None:
+    """The terrain and style presets against the defaults on held-out terrains: paired runs per cell.
+
+    A terrain preset passes with a per-stride error >= 2 SE better on its terrain and <= 1 SE worse \
+elsewhere; a style preset with its style metric >= 2 SE toward its bound; neither with more collisions.
+    """
+    from footfall._atomic import write_text_atomic
+    from footfall._distribute import check_workers, task_runner
+    from tuning._matrix import PRESETS, run_matrix
+
+    check_workers(workers, cluster)
+    chosen = tuple(n.strip() for n in names.split(",") if n.strip()) if names else tuple(PRESETS)
+    for name in chosen:
+        if name not in PRESETS:
+            raise InputError("argument", "--presets", f"unknown preset {name!r}; expected {', '.join(PRESETS)}")
+    if out is not None and not out.endswith(".json"):
+        raise InputError("argument", "--out", f"expected a .json path, got {out!r}")
+    with _err().status("proving the presets...") as status, task_runner(workers, cluster) as map_tasks:
+        matrix = run_matrix(presets_dir, chosen, runs=runs, map_tasks=map_tasks,
+                            progress=lambda m: status.update(f"proving the presets: {m}"))
+    if out is not None:
+        write_text_atomic(out, json.dumps(matrix, indent=1, allow_nan=False) + "\n")
+    if json_out:
+        print(json.dumps(matrix))
+        return
+    _stdout().print(matrix_table(matrix))
+
+
+def matrix_table(matrix: dict) -> Table:
+    """The preset x terrain matrix: per cell, the main (or style) metric's gain in SE, default -> preset."""
+    terrains = list(matrix["terrains"])
+    table = Table(title=f"presets vs defaults on held-out terrains ({matrix['runs_per_cell']} paired runs per cell; "
+                  "gain in SE, > 0 = better)")
+    table.add_column("preset")
+    for t in terrains:
+        table.add_column(t, justify="right")
+    table.add_column("passes")
+    for name, p in matrix["presets"].items():
+        if not p["found"]:
+            table.add_row(name, *["-"] * len(terrains), "not found")
+            continue
+        row = []
+        for t in terrains:
+            cell = p["cells"][t]
+            main = cell["main"]
+            text = (f"{main['default']:.3f}->{main['preset']:.3f} ({main['gain_se']:+.1f})"
+                    if main["default"] is not None and main["gain_se"] is not None else "-")
+            for key, s in cell["style"].items():
+                if s["gain_se"] is not None:
+                    text += f"\n{s['metric']} {s['default']:.3g}->{s['preset']:.3g} ({s['gain_se']:+.1f})"
+            row.append(text)
+        table.add_row(name, *row, "yes" if p["passes"] else "no: " + "; ".join(p["why"]))
+    return table
 
 
 @bench_app.command("planner")

@@ -78,7 +78,7 @@ class EventTuneConfig:
     targets_file: str | None = None
     rounds: int = 3
     seed: int = 0
-    seeds: tuple[int, ...] = (0, 1)
+    seeds: tuple[int, ...] = (0, 1, 2)
     frames: int = EVENT_FRAMES
     characters: int = 1
     spawn_fractions: tuple[float, ...] = SPAWN_FRACTIONS
@@ -88,7 +88,7 @@ class EventTuneConfig:
     fit_steps: int = 12
     tau: float = TAU
     holdout_scenarios: tuple[str, ...] | None = None  # None: heldout_variant of each scenario
-    holdout_seeds: tuple[int, ...] = (101, 102)
+    holdout_seeds: tuple[int, ...] = (101, 102, 103)
     gain_noise_se: float = GAIN_NOISE_SE
 
     def __post_init__(self) -> None:
