@@ -269,7 +269,7 @@ def test_acceptance_needs_a_paired_gain_beyond_the_noise_and_no_more_collisions(
 
     def metrics(losses, collisions=0):
         return {"finite": True, "collisions": collisions, "exact_loss": float(np.mean(losses)),
-                "runs": [{"run_loss": x} for x in losses]}
+                "runs": [{"run_loss": x, "collisions": collisions} for x in losses]}
 
     best = metrics([1.0, 1.0, 1.0, 1.0])
     assert accept(metrics([0.5, 0.5, 0.5, 0.6]), best, best, 2.0) == (True, "improved")
@@ -283,7 +283,8 @@ def test_acceptance_needs_a_paired_gain_beyond_the_noise_and_no_more_collisions(
 
 
 def _events(values, key="stride_error", collisions=0, **other):
-    runs = [{key: v, **{k: o[i] for k, o in other.items()}} for i, v in enumerate(values)]
+    runs = [{key: v, "collisions": collisions if i == 0 else 0, **{k: o[i] for k, o in other.items()}}
+            for i, v in enumerate(values)]
     return {"runs": runs, "collisions": collisions}
 
 
@@ -304,7 +305,9 @@ def test_a_terrain_preset_passes_only_with_a_win_at_home_and_no_loss_elsewhere()
     assert not passes and "crates" in why[0]
     cells = {"stairs": evaluate_cell(default, same, {}), "crates": evaluate_cell(default, same, {})}
     assert not verdict("spider-stairs", cells, {})[0]
-    collided = evaluate_cell(default, {**better, "collisions": 1}, {})
+    better_values = [r["stride_error"] for r in better["runs"]]
+    collided = evaluate_cell(default, _events(better_values, collisions=1), {})  # one run with a collision
+    assert collided["collisions_rise"]
     assert not verdict("spider-stairs", {"stairs": collided}, {})[0]
 
 

@@ -14,8 +14,8 @@ the ``stairs`` runs stop before the first riser and the ``mixed`` runs never mee
   metrics (:class:`planner._simulation.SimulationSummary`), not re-derived here;
 * measured beside them, from the plans of the run (every valid plan of a swing; the last plan of a
   swing is where its foot touches down): the curvature energy's 95th percentile, the touch-down
-  slope and roughness under the planned footprints, the swing paths' clearance to forbidden
-  cells (5th percentile, in body heights h), and the distance walked / asked.
+  slope and roughness under the planned footprints, the touch-downs' clearance to forbidden
+  boxes (5th percentile, in body heights h), and the distance walked / asked.
 
 Per run (:data:`EVENT_METRICS`):
 
@@ -28,10 +28,14 @@ Per run (:data:`EVENT_METRICS`):
 * ``touchdown_slope_rad``, ``touchdown_roughness_m``: mean over the plans of the slope and the
   roughness under the footprint, from the plan's goodnesses and the run's reference scales
   (s = 1 - x / critical, so x = (1 - s) critical; a goodness of 0 gives the critical value, a lower bound);
-* ``clearance_p05_h``: 5th percentile of the plans' horizontal clearance to blocked cells / h
-  (capped at :data:`CLEARANCE_CAP_H`: +inf when nothing is blocked around a path);
-* ``distance_ratio``: ground distance the pelvis walked / what the asked speed would have walked,
-  over the frames a character had not yet arrived.
+* ``clearance_p05_h``: 5th percentile over the touch-downs of the foot's horizontal distance to the
+  nearest forbidden box (its footprint rectangle at that time, the boxes the creature may not step
+  on) / h, capped at :data:`CLEARANCE_CAP_H` (no forbidden box: the cap). The plans' own clearance
+  metric (``RAW_CLEARANCE``) is not used: it counts the other legs' cells as blocked, so its 5th
+  percentile is one cell whatever the weights;
+* ``distance_ratio``: ground distance the pelvis walked / what the asked speed (at most the cap) would
+  have walked, over the frames after the first second (the start from standing) in which a character
+  had not yet arrived.
 
 Run loss (what the line search and the held-out comparison add up, paired run by run)::
 
@@ -53,7 +57,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from planner._harvest import task_mapper
-from planner._kernels_foot import RAW_CLEARANCE, RAW_CURVATURE
+from planner._kernels_foot import RAW_CURVATURE
 
 EVENT_FRAMES = 300
 SPAWN_FRACTIONS = (0.15, 0.3, 0.45)
@@ -178,22 +182,33 @@ def run_event_task(task: dict) -> dict:
         w = weights.to_array()
         h = hip_height(creature)
         goal = np.minimum(state.desired_speed, model.speed_cap)
-        curvature, clearance, slope, rough = [], [], [], []
+        curvature, slope, rough, clearance = [], [], [], []
+        obstacles = model.raster.obstacles
+        forbidden = np.asarray(obstacles.forbidden, dtype=np.bool_) if len(obstacles.yaws) else np.zeros(0, bool)
+        half = 0.5 * np.asarray(obstacles.sizes, dtype=np.float64)[forbidden][:, [0, 2]] if forbidden.any() else None
+        prev = [state.in_stance.copy()]
         walked = np.zeros(state.pelvis.shape[0])
         asked = np.zeros(state.pelvis.shape[0])
         before = [state.pelvis[:, [0, 2]].copy()]
 
-        def after(_k):
+        started = int(round(1.0 / model.dt))
+
+        def after(k):
             now = state.pelvis[:, [0, 2]]
-            walking = ~arrived(model, state)
+            walking = ~arrived(model, state) & (k > started)
             walked[walking] += np.hypot(*(now - before[0]).T)[walking]
             asked[walking] += goal[walking] * model.dt
             before[0] = now.copy()
+            landed = state.in_stance & ~prev[0]
+            prev[0] = state.in_stance.copy()
+            if half is not None and landed.any():
+                centres, yaws = obstacles.poses_at(state.t)
+                feet = state.feet[landed][:, [0, 2]]
+                clearance.append(box_distance(feet, centres[forbidden][:, [0, 2]], half, yaws[forbidden]).min(axis=1))
             if state.last_plans is not None:
                 out = state.last_plans[3]
                 ok = out.valid
                 curvature.append(out.raw[ok, RAW_CURVATURE])
-                clearance.append(out.raw[ok, RAW_CLEARANCE])
                 slope.append((1.0 - out.terms[ok, 2]) * w[W_SLOPE_CRITICAL])
                 rough.append((1.0 - out.terms[ok, 1]) * w[W_STEP_CRITICAL])
 
@@ -205,7 +220,7 @@ def run_event_task(task: dict) -> dict:
         return np.concatenate(parts) if parts else np.zeros(0)
 
     curvature, clearance, slope, rough = cat(curvature), cat(clearance), cat(slope), cat(rough)
-    clear_h = np.minimum(np.where(np.isfinite(clearance), clearance, np.inf) / h, CLEARANCE_CAP_H)
+    clear_h = np.minimum(clearance / h, CLEARANCE_CAP_H)
     steps = max(int(summary["steps"]), 1)
     goal_speed = min(summary["speed_asked"], summary["speed_cap"] if summary["speed_cap"] is not None else math.inf)
     error = summary["stride_rel_error_median"]
@@ -224,6 +239,17 @@ def run_event_task(task: dict) -> dict:
     return {"scenario": task["scenario"], "base": task["base"], "spawn": task["spawn"], "seed": task["seed"],
             "metrics": metrics, "finite": bool(summary["finite"]), "strides": int(summary["strides_measured"]),
             "replay": replay_command(task)}
+
+
+def box_distance(points, centres, half, yaws):
+    """(P, B) horizontal distance of points (P, 2) to oriented rectangles (B: centres (B, 2), half
+    extents (B, 2) along the box's local x and z, yaws (B,)); 0 inside. The box frame is the
+    runtime's (``planner._kernels_avoidance._nearest_on_box``): local x = (cos yaw, sin yaw)."""
+    d = points[:, None, :] - centres[None, :, :]
+    c, s = np.cos(yaws)[None, :], np.sin(yaws)[None, :]
+    a = d[..., 0] * c + d[..., 1] * s
+    b = -d[..., 0] * s + d[..., 1] * c
+    return np.hypot(np.maximum(np.abs(a) - half[None, :, 0], 0.0), np.maximum(np.abs(b) - half[None, :, 1], 0.0))
 
 
 def _hinge(ratio: float) -> float:
@@ -288,3 +314,19 @@ def paired(a: dict, b: dict, key: str = "run_loss") -> tuple[float, float, int]:
     if d.size < 2:
         return math.nan, math.nan, int(d.size)
     return float(d.mean()), float(d.std(ddof=1) / math.sqrt(d.size)), int(d.size)
+
+
+COLLISION_NOISE_SE = 1.0
+"""Collisions (feet in boxes, bodies in bodies) rise when their paired mean increase is positive and
+at least this many standard errors (a rise from 0 in every run is always one): the counts are
+foot-frames of rare, chaotic events, so a strict 'no more than the defaults' refused on noise."""
+
+
+def collisions_rise(default: dict, other: dict) -> tuple[bool, float, float]:
+    """(rises, mean, SE) of other's collisions - default's, paired run by run."""
+    x = np.array([r["collisions"] for r in default["runs"]], dtype=np.float64)
+    y = np.array([r["collisions"] for r in other["runs"]], dtype=np.float64)
+    d = y - x
+    mean = float(d.mean()) if d.size else 0.0
+    se = float(d.std(ddof=1) / math.sqrt(d.size)) if d.size > 1 else 0.0
+    return bool(mean > 0.0 and mean >= COLLISION_NOISE_SE * se), mean, se

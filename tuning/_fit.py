@@ -53,6 +53,8 @@ whatever the number of situations:
     off without one);
   - detour, per situation: relu(E[path length / straight distance] min_distance_ratio - 1) (a style's
     minimum distance ratio: a swing's detour makes the body walk less of what was asked; off without);
+  - touch-down clearance, per situation: relu(1 - E[min(obstacle distance, c)] / c), c = the style's
+    minimum clearance (body heights x h): footprints kept away from forbidden boxes (off without one);
   - curvature p95, per situation: relu(E[E] / curvature_p95_max - 1): situations above a style's
     ceiling (the per-situation hinge stands for the 95th percentile of the runs; off without one).
 
@@ -80,7 +82,7 @@ from tuning._proxies import Situations, duty_factor, expected_metrics, stride_fr
 
 FITTED_TIMING = ("stride_coefficient", "stride_exponent", "duty_at_rest", "duty_slope")
 _FITTED_INDEX = np.array([TIMING_FIELDS.index(n) for n in FITTED_TIMING])
-WEIGHT_BLOCKS = ("offset", "touchdown_slope", "detour", "curvature_p95")
+WEIGHT_BLOCKS = ("offset", "touchdown_slope", "detour", "touchdown_clearance", "curvature_p95")
 """The weights' residual blocks, in the order of :func:`residuals` (module docstring)."""
 PRIOR_LOG_SCALE = 1.0
 """A factor e away from the harvest's value costs as much as one target missed by its tolerance."""
@@ -111,6 +113,7 @@ class FitProblem(eqx.Module):
     slope_max: jax.Array  # (F,) the style's touch-down slope ceiling (rad; inf: none)
     detour_max: jax.Array  # (F,) 1 / the style's minimum distance ratio (inf: none)
     curvature_p95_max: jax.Array  # (F,) the style's curvature p95 ceiling (inf: none)
+    touchdown_clearance_m: jax.Array  # (F,) the style's minimum clearance to forbidden boxes (m; 0: none)
     fit_timing: bool = eqx.field(static=True, default=True)
 
 
@@ -172,6 +175,8 @@ def make_problem(situations: Situations, creature_names, targets, tau: float, je
         detour_max=col(lambda t: 1.0 / _style(t, "min_distance_ratio", weights_blocks, 0.0) if _style(
             t, "min_distance_ratio", weights_blocks, 0.0) > 0.0 else np.inf),
         curvature_p95_max=col(lambda t: _style(t, "curvature_p95_max", weights_blocks)),
+        touchdown_clearance_m=col(lambda t: _style(t, "min_clearance_body_heights", weights_blocks, 0.0)
+                                  * t.leg_length_m),
         fit_timing=bool(fit_timing))
 
 
@@ -199,7 +204,12 @@ def residuals(params, problem: FitProblem):
     s = problem.situations
     w = jnp.exp(log_weights)
     timing = timing_vector(log_timing, s.timing0)
-    m = expected_metrics(w, timing, s, problem.tau, clearance_cap_m=problem.clearance_min_m)
+    # The touch-down clearance is capped at the style's minimum where there is one (the path clearance
+    # at the clearance target, as before).
+    td_on = problem.touchdown_clearance_m > 0.0
+    m = expected_metrics(w, timing, s, problem.tau, clearance_cap_m=problem.clearance_min_m,
+                         touchdown_cap_m=jnp.where(td_on, problem.touchdown_clearance_m, 1.0))
+    td = m["touchdown_clearance_m"]
     moving = s.speed > 0.0
     frequency = stride_frequency(timing, s.speed, s.leg_height)
     commanded = jnp.where(moving, s.speed / jnp.where(moving, frequency, 1.0), 0.0)
@@ -228,6 +238,7 @@ def residuals(params, problem: FitProblem):
     slope_hinge = jax.nn.relu(m["touchdown_slope_rad"] / jnp.where(slope_on, problem.slope_max, 1.0) - 1.0)
     detour_on = jnp.isfinite(problem.detour_max)
     detour = jax.nn.relu(m["detour_ratio"] / jnp.where(detour_on, problem.detour_max, 1.0) - 1.0)
+    td_hinge = jax.nn.relu(1.0 - td / jnp.where(td_on, problem.touchdown_clearance_m, 1.0))
     curv_on = jnp.isfinite(problem.curvature_p95_max)
     curv = jax.nn.relu(m["curvature_energy"] / jnp.where(curv_on, problem.curvature_p95_max, 1.0) - 1.0)
     return jnp.concatenate([
@@ -240,6 +251,7 @@ def residuals(params, problem: FitProblem):
         _block(jnp.where(problem.stride_mask, offset, 0.0), problem.stride_mask & (problem.offset_weight > 0.0)),
         _block(slope_hinge, slope_on),
         _block(detour, detour_on),
+        _block(td_hinge, td_on),
         _block(curv, curv_on),
         (log_weights - problem.log_weights0) / PRIOR_LOG_SCALE,
         (log_timing - problem.log_timing0) / PRIOR_LOG_SCALE,

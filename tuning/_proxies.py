@@ -66,7 +66,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from planner._kernels_foot import FEAT_DISTANCE, FEAT_ROUGHNESS, FEAT_SLOPE, N_FEATURES, N_RAW, RAW_CLEARANCE, RAW_CLIMB
+from planner._kernels_foot import FEAT_DISTANCE, FEAT_PROXIMITY, FEAT_ROUGHNESS, FEAT_SLOPE, N_FEATURES, N_RAW, RAW_CLEARANCE, RAW_CLIMB
 from planner._kernels_foot import RAW_CURVATURE, RAW_JERK, RAW_LENGTH
 from planner._timing import (
     GRAVITY,
@@ -88,7 +88,7 @@ LEAST_FREQUENCY_HZ = 1e-3
 KIND_REPLAN = 3
 
 PROXY_METRICS = ("step_length_m", "forward_offset_m", "offset_m", "touchdown_slope_rad", "touchdown_roughness_m",
-                 "detour_ratio", "length_m", "curvature_energy", "clearance_m", "climb_m", "jerk", "couple_score")
+                 "detour_ratio", "touchdown_clearance_m", "length_m", "curvature_energy", "clearance_m", "climb_m", "jerk", "couple_score")
 """Keys of :func:`expected_metrics`, each (F,) per situation:
 
 * ``step_length_m``: horizontal distance source -> target;
@@ -101,6 +101,9 @@ PROXY_METRICS = ("step_length_m", "forward_offset_m", "offset_m", "touchdown_slo
   step to a neighbour cell) under the chosen footprint (``planner.FEATURES``);
 * ``detour_ratio``: the swing path's ground length / the straight distance source -> footprint
   (``d_ref``): 1 for a direct swing, more for a detour around or over an obstacle;
+* ``touchdown_clearance_m``: the footprint's distance to forbidden cells (``obstacle_distance_m``,
+  the creature-dilated forbidden region of the local map), capped at ``clearance_cap_m`` as the
+  path clearance is (+inf when no forbidden cell is in the map);
 * ``length_m``, ``curvature_energy``, ``clearance_m``, ``climb_m``, ``jerk``: the raw
   trajectory metrics (``planner.RAW_METRICS``); the clearance is capped at
   ``clearance_cap_m`` (a number or (F,); +inf when nothing is blocked around a path);
@@ -246,12 +249,13 @@ def soft_selection(scores, mask, tau):
     return (e / jnp.sum(e, axis=1, keepdims=True)).reshape(scores.shape)
 
 
-def expected_metrics(weights, timing, situations: Situations, tau, clearance_cap_m=jnp.inf):
+def expected_metrics(weights, timing, situations: Situations, tau, clearance_cap_m=jnp.inf, touchdown_cap_m=None):
     """Expectations under the soft selection at temperature ``tau`` (> 0): a dict of (F,)
-    arrays keyed by :data:`PROXY_METRICS`."""
+    arrays keyed by :data:`PROXY_METRICS`. ``touchdown_cap_m``: the cap of ``touchdown_clearance_m``
+    (a number or (F,); None: ``clearance_cap_m``)."""
     scores = couple_scores(weights, timing, situations)
     p = soft_selection(scores, situations.couple_mask, tau)
-    return _metrics_under(p, scores, timing, situations, clearance_cap_m)
+    return _metrics_under(p, scores, timing, situations, clearance_cap_m, touchdown_cap_m)
 
 
 def hard_metrics(weights, timing, situations: Situations, clearance_cap_m=jnp.inf):
@@ -265,7 +269,7 @@ def hard_metrics(weights, timing, situations: Situations, clearance_cap_m=jnp.in
     return _metrics_under(one_hot, scores, timing, s, clearance_cap_m)
 
 
-def _metrics_under(p, scores, timing, s, clearance_cap_m):
+def _metrics_under(p, scores, timing, s, clearance_cap_m, touchdown_cap_m=None):
     """The PROXY_METRICS under the selection p (F, K, S)."""
     pref = preferred_footprint(timing, s)
 
@@ -283,6 +287,13 @@ def _metrics_under(p, scores, timing, s, clearance_cap_m):
     cap = jnp.asarray(clearance_cap_m, dtype=clearance.dtype)
     cap = cap.reshape(cap.shape + (1,) * (clearance.ndim - cap.ndim))  # a number or (F,) per situation
     capped = jnp.where(finite, jnp.minimum(jnp.where(finite, clearance, 0.0), cap), cap)
+    prox = s.cand_features[..., FEAT_PROXIMITY]
+    prox_finite = jnp.isfinite(prox)
+    cap_k = cap[..., 0]  # (1, 1) or (F, 1): per candidate
+    if touchdown_cap_m is not None:
+        cap_k = jnp.asarray(touchdown_cap_m, dtype=clearance.dtype)
+        cap_k = cap_k.reshape(cap_k.shape + (1,) * (2 - cap_k.ndim))
+    prox_capped = jnp.where(prox_finite, jnp.minimum(jnp.where(prox_finite, prox, 0.0), cap_k), cap_k)
     shape = raw.shape[:-1]
 
     def per_candidate(values):  # (F, K) -> (F, K, S)
@@ -295,6 +306,7 @@ def _metrics_under(p, scores, timing, s, clearance_cap_m):
         "touchdown_slope_rad": expect(per_candidate(s.cand_features[..., FEAT_SLOPE])),
         "touchdown_roughness_m": expect(per_candidate(s.cand_features[..., FEAT_ROUGHNESS])),
         "detour_ratio": expect(raw[..., RAW_LENGTH] / d_ref[..., None]),
+        "touchdown_clearance_m": expect(per_candidate(jnp.broadcast_to(prox_capped, step.shape))),
         "length_m": expect(raw[..., RAW_LENGTH]),
         "curvature_energy": expect(raw[..., RAW_CURVATURE]),
         "clearance_m": expect(capped),

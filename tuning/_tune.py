@@ -334,6 +334,7 @@ def _pad_problem(problem, n: int, k: int, s: int):
         slope_max=jnp.asarray(pad(problem.slope_max, np.inf, rows)),
         detour_max=jnp.asarray(pad(problem.detour_max, np.inf, rows)),
         curvature_p95_max=jnp.asarray(pad(problem.curvature_p95_max, np.inf, rows)),
+        touchdown_clearance_m=jnp.asarray(pad(problem.touchdown_clearance_m, 0.0, rows)),
         creature_one_hot=jnp.asarray(pad(problem.creature_one_hot, 0.0, rows)))
 
 

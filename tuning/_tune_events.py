@@ -14,8 +14,8 @@ Each outer round r (``rounds`` at most):
    temperature :data:`TAU`): soft expectations of the offset from the preferred footprint and of the
    style's quantities, with real gradients for every weight;
 3. **exact objective** (:mod:`tuning._events`) along the fitted step, a backtracking line search
-   (:data:`tuning._tune.LINE_SEARCH`): a candidate is accepted if it is finite, has no more
-   collisions and body overlaps than the defaults, and lowers the paired per-run loss of the best so
+   (:data:`tuning._tune.LINE_SEARCH`): a candidate is accepted if it is finite, its collisions and
+   body overlaps do not rise over the defaults' (:func:`tuning._events.collisions_rise`), and lowers the paired per-run loss of the best so
    far by at least ``gain_noise_se`` standard errors.
 
 Then the **held-out** runs: other terrains' parameters and other seeds (:func:`heldout_variant`,
@@ -39,7 +39,8 @@ import numpy as np
 
 from footfall._atomic import write_text_atomic
 from footfall._errors import InputError
-from tuning._events import EVENT_FRAMES, SPAWN_FRACTIONS, EventSetup, event_metrics, paired, spawn_variant
+from tuning._events import (EVENT_FRAMES, SPAWN_FRACTIONS, EventSetup, collisions_rise, event_metrics, paired,
+                            spawn_variant)
 from tuning._tune import (LINE_SEARCH, TuneResult, _bucket, _floats, _objects, _pad_problem, _towards, check_creature,
                           check_output, checkpoint_path)
 
@@ -163,8 +164,9 @@ def accept(candidate: dict, best: dict, default: dict, gain_noise_se: float) -> 
     """(accepted, why) of a candidate's event metrics against the best so far and the defaults'."""
     if not candidate["finite"]:
         return False, "non-finite run"
-    if candidate["collisions"] > default["collisions"]:
-        return False, "more collisions and body overlaps than the defaults"
+    rises, mean, se = collisions_rise(default, candidate)
+    if rises:
+        return False, f"more collisions and body overlaps than the defaults (+{mean:.3g} per run, SE {se:.3g})"
     if not candidate["exact_loss"] < best["exact_loss"]:
         return False, "loss did not improve"
     gain, se, _ = paired(best, candidate)

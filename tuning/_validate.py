@@ -29,12 +29,10 @@ PAIRS = (
     ("offset_m", "stride_error", 1.0),
     ("touchdown_slope_rad", "touchdown_slope_rad", 1.0),
     ("touchdown_roughness_m", "touchdown_roughness_m", 1.0),
-    ("clearance_m", "clearance_p05_h", 1.0),
+    ("touchdown_clearance_m", "clearance_p05_h", 1.0),
     ("curvature_energy", "curvature_p95", 1.0),
 )
 """(proxy metric, run metric, sign): the run metric is expected to move as sign x the proxy's."""
-CLEARANCE_CAP_H = 2.0
-"""The proxy's clearance is capped at this many body heights (+inf when nothing is blocked)."""
 
 
 def candidate_weights(n: int, seed: int) -> list[np.ndarray]:
@@ -59,7 +57,7 @@ def metric_change_spearman(config, targets, n: int, map_tasks=None) -> dict:
     from planner._harvest import harvest_situations
     from planner._weights import ScoringWeights
     from tuning._config import enable_x64
-    from tuning._events import event_metrics, spawn_variant
+    from tuning._events import CLEARANCE_CAP_H, event_metrics, spawn_variant
     from tuning._proxies import expected_metrics, situations_from_harvest
     from tuning._tune_events import HARVEST_SPAWN
 
@@ -76,7 +74,7 @@ def metric_change_spearman(config, targets, n: int, map_tasks=None) -> dict:
     t = jnp.asarray(timing.to_array())
 
     def proxy(w):
-        m = expected_metrics(jnp.asarray(w), t, situations, config.tau, clearance_cap_m=cap)
+        m = expected_metrics(jnp.asarray(w), t, situations, config.tau, clearance_cap_m=cap, touchdown_cap_m=cap)
         return {k: float(jnp.mean(m[k])) for k, _, _ in PAIRS}
 
     setup = config.setup()
