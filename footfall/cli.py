@@ -698,6 +698,8 @@ def bench_presets_cmd(
                                         "and style preset of tuning._matrix.PRESETS)"),
     runs: int = typer.Option(30, "--runs", min=2, help="Paired runs per preset x terrain cell"),
     out: Optional[str] = typer.Option(None, "--out", help="Write the matrix here (.json), e.g. tuning/data/matrix.json"),
+    prune: bool = typer.Option(False, "--prune", help="Delete from --presets-dir the presets that do not pass (only "
+                               "a passing preset ships)"),
     cluster: Optional[str] = typer.Option(None, help="Dask scheduler address to run the runs on"),
     workers: Optional[int] = typer.Option(None, help="Local worker processes (default: one per core; 1: in-process)"),
     json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),
@@ -723,6 +725,15 @@ elsewhere; a style preset with its style metric >= 2 SE toward its bound; neithe
                             progress=lambda m: status.update(f"proving the presets: {m}"))
     if out is not None:
         write_text_atomic(out, json.dumps(matrix, indent=1, allow_nan=False) + "\n")
+    if prune:
+        from pathlib import Path
+
+        for name, p in matrix["presets"].items():
+            if p["found"] and not p["passes"]:
+                (Path(presets_dir) / f"{name}.json").unlink()
+                checkpoint = Path(presets_dir) / f"{name}.json.checkpoint.json"
+                checkpoint.unlink(missing_ok=True)
+                _err().print(f"footfall: note: {name} does not pass; removed from {presets_dir}", markup=False)
     if json_out:
         print(json.dumps(matrix))
         return

@@ -199,11 +199,13 @@ def test_the_run_loss_is_its_formula(one_run):
     assert run_loss(m, targets) == pytest.approx((m["stride_error"] / tol) ** 2 + m["holds_per_100_steps"] / HOLDS_REF
                                                  + 2 * COLLISION_PENALTY)
     # A style's hinges: 0 when met, log ratio when not, each in its direction.
-    style = {"min_clearance_body_heights": 2.0 * m["clearance_p05_h"], "max_touchdown_slope_rad": 1.0,
+    m["near_box_share"] = 0.1
+    style = {"min_clearance_body_heights": 1.0, "max_touchdown_slope_rad": 0.5 * m["touchdown_slope_rad"],
              "min_distance_ratio": 0.5 * m["distance_ratio"]}
     terms = style_terms(m, style)
-    assert terms["min_clearance_body_heights"] == pytest.approx(math.log(2.0))
-    assert terms["max_touchdown_slope_rad"] == 0.0 and terms["min_distance_ratio"] == 0.0
+    assert terms["min_clearance_body_heights"] == pytest.approx(0.1 / 0.05)
+    assert terms["max_touchdown_slope_rad"] == pytest.approx(math.log(2.0))
+    assert terms["min_distance_ratio"] == 0.0
 
 
 # --------------------------------------------------------------------------- the tune
@@ -315,12 +317,12 @@ def test_a_style_preset_passes_when_its_metric_moves_toward_its_bound():
     from tuning._matrix import evaluate_cell, verdict
 
     rng = np.random.default_rng(1)
-    clear = 0.5 + 0.05 * rng.standard_normal(30)
+    near = 0.2 + 0.02 * rng.standard_normal(30)
     stride = np.full(30, 0.05)
-    style = {"min_clearance_body_heights": 1.0}
-    default = _events(stride, clearance_p05_h=clear)
-    up = _events(stride, clearance_p05_h=clear + 0.1 + 0.02 * rng.standard_normal(30))
-    down = _events(stride, clearance_p05_h=clear - 0.1)
+    style = {"min_clearance_body_heights": 1.0}  # toward it: fewer touch-downs near a box
+    default = _events(stride, near_box_share=near)
+    up = _events(stride, near_box_share=near - 0.05 + 0.01 * rng.standard_normal(30))
+    down = _events(stride, near_box_share=near + 0.05)
     good = {t: evaluate_cell(default, up, style) for t in ("crates", "mixed")}
     assert good["crates"]["style"]["min_clearance_body_heights"]["gain_se"] > 2.0
     assert verdict("spider-cautious", good, style) == (True, [])

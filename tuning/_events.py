@@ -33,6 +33,9 @@ Per run (:data:`EVENT_METRICS`):
   on) / h, capped at :data:`CLEARANCE_CAP_H` (no forbidden box: the cap). The plans' own clearance
   metric (``RAW_CLEARANCE``) is not used: it counts the other legs' cells as blocked, so its 5th
   percentile is one cell whatever the weights;
+* ``near_box_share``: the share of the touch-downs closer than the clearance target to a forbidden box
+  (the style's ``min_clearance_body_heights`` x h, else the ``clearance`` target's minimum x h): most
+  touch-downs are far from every box (the crowd steers around them), so a percentile says little;
 * ``distance_ratio``: ground distance the pelvis walked / what the asked speed (at most the cap) would
   have walked, over the frames after the first second (the start from standing) in which a character
   had not yet arrived.
@@ -42,9 +45,9 @@ Run loss (what the line search and the held-out comparison add up, paired run by
     (stride_error / relative_tolerance)^2 + holds_per_100_steps / HOLDS_REF
     + COLLISION_PENALTY * collisions + sum over the style's keys of hinge^2,
 
-hinges in log ratios (scale-free, 0 when the style is met): relu(log(clearance_min / clearance_p05_h)),
-relu(log(curvature_p95 / ceiling)), relu(log(min_distance_ratio / distance_ratio)),
-relu(log(touchdown_slope_rad / ceiling)).
+hinges (0 when the style is met): near_box_share / NEAR_SHARE_REF for the minimum clearance, and
+log ratios (scale-free) for the others: relu(log(curvature_p95 / ceiling)),
+relu(log(min_distance_ratio / distance_ratio)), relu(log(touchdown_slope_rad / ceiling)).
 """
 
 from __future__ import annotations
@@ -67,12 +70,16 @@ HOLDS_REF = 10.0
 COLLISION_PENALTY = 1.0
 CLEARANCE_CAP_H = 10.0
 LOG_FLOOR = 1e-6
+NEAR_SHARE_REF = 0.05
+"""A share of touch-downs near a box that costs as much as a stride error of one tolerance."""
 EVENT_METRICS = ("stride_error", "speed_ratio", "holds_per_100_steps", "stuck_s_per_100_steps", "collisions",
-                 "curvature_p95", "touchdown_slope_rad", "touchdown_roughness_m", "clearance_p05_h", "distance_ratio")
-STYLE_METRIC = {"min_clearance_body_heights": "clearance_p05_h", "curvature_p95_max": "curvature_p95",
+                 "curvature_p95", "touchdown_slope_rad", "touchdown_roughness_m", "clearance_p05_h", "near_box_share",
+                 "distance_ratio")
+STYLE_METRIC = {"min_clearance_body_heights": "near_box_share", "curvature_p95_max": "curvature_p95",
                 "min_distance_ratio": "distance_ratio", "max_touchdown_slope_rad": "touchdown_slope_rad"}
 """The run metric each style key bounds."""
-LOWER_BOUND_STYLES = ("min_clearance_body_heights", "min_distance_ratio")
+LOWER_BOUND_STYLES = ("min_distance_ratio",)
+"""Style keys whose metric moves toward the bound by rising (the others: by falling)."""
 
 
 @dataclass(frozen=True)
@@ -237,7 +244,7 @@ def run_event_task(task: dict) -> dict:
         "distance_ratio": float(walked.sum() / asked.sum()) if asked.sum() > 0 else math.nan,
     }
     return {"scenario": task["scenario"], "base": task["base"], "spawn": task["spawn"], "seed": task["seed"],
-            "metrics": metrics, "finite": bool(summary["finite"]), "strides": int(summary["strides_measured"]),
+            "metrics": metrics, "touchdown_clearance_h": clear_h, "finite": bool(summary["finite"]), "strides": int(summary["strides_measured"]),
             "replay": replay_command(task)}
 
 
@@ -261,7 +268,9 @@ def style_terms(metrics: dict, style: dict | None) -> dict[str, float]:
     out = {}
     for key, bound in (style or {}).items():
         value = metrics[STYLE_METRIC[key]]
-        if key in LOWER_BOUND_STYLES:
+        if key == "min_clearance_body_heights":  # the share of touch-downs nearer than the bound
+            out[key] = value / NEAR_SHARE_REF
+        elif key in LOWER_BOUND_STYLES:
             out[key] = _hinge(bound / max(value, LOG_FLOOR))
         else:
             out[key] = _hinge(value / bound)
@@ -287,10 +296,13 @@ def event_metrics(setup: EventSetup, weights, timing, targets, map_tasks=None) -
     (each with its ``run_loss``)."""
     run = task_mapper(map_tasks)
     results = list(run(run_event_task, event_tasks(setup, weights, timing)))
+    near = targets.clearance_min_m / targets.leg_length_m
     runs = []
     for r in results:
+        clear = np.asarray(r["touchdown_clearance_h"])
+        metrics = {**r["metrics"], "near_box_share": float(np.mean(clear < near)) if clear.size else 0.0}
         runs.append({**{k: r[k] for k in ("scenario", "base", "spawn", "seed", "strides", "replay")},
-                     **r["metrics"], "run_loss": run_loss(r["metrics"], targets)})
+                     **metrics, "run_loss": run_loss(metrics, targets)})
     means = {}
     for key in EVENT_METRICS:
         values = np.array([r[key] for r in runs], dtype=np.float64)

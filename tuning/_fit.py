@@ -119,14 +119,14 @@ class FitProblem(eqx.Module):
 
 def make_problem(situations: Situations, creature_names, targets, tau: float, jerk_weight: float = 0.0,
                  stride_correction=None, duty_correction=None, weights_blocks: bool = False,
-                 fit_timing: bool = True) -> FitProblem:
+                 fit_timing: bool = True, offset_weight: float = 1.0) -> FitProblem:
     """``creature_names``: the harvest's ``creatures`` (``situations.creature`` indexes it);
     ``targets``: :func:`tuning.load_targets` output holding those creatures; ``jerk_weight``:
     weight of the jerk block (0: off, the default; module docstring); ``stride_correction``:
     c per situation (F,), realised / commanded stride (None: 1, the timing model taken at its word);
     ``duty_correction``: d per situation (F,), realised - commanded duty factor (None: 0);
-    ``weights_blocks``: the weights' blocks (offset, and the style's ceilings where the targets state
-    a style; module docstring); ``fit_timing`` False: the timing is held at the harvest's (its
+    ``weights_blocks``: the weights' blocks (offset, weighted ``offset_weight``, and the style's bounds
+    where the targets state a style; module docstring); ``fit_timing`` False: the timing is held at the harvest's (its
     Jacobian columns are zero and its prior keeps it there): a tune of the weights alone."""
     if not tau > 0.0:
         raise ValueError(f"tau: expected a temperature > 0, got {tau!r}")
@@ -170,7 +170,7 @@ def make_problem(situations: Situations, creature_names, targets, tau: float, je
         creature_one_hot=jnp.asarray(index[:, None] == np.arange(len(creature_names))[None, :], dtype=jnp.float64),
         log_weights0=jnp.log(jnp.asarray(weights0)), log_timing0=jnp.log(jnp.asarray(timing0[_FITTED_INDEX])),
         jerk_weight=jnp.asarray(float(jerk_weight), dtype=jnp.float64),
-        offset_weight=jnp.asarray(1.0 if weights_blocks else 0.0, dtype=jnp.float64),
+        offset_weight=jnp.asarray(float(offset_weight) if weights_blocks else 0.0, dtype=jnp.float64),
         slope_max=col(lambda t: _style(t, "max_touchdown_slope_rad", weights_blocks)),
         detour_max=col(lambda t: 1.0 / _style(t, "min_distance_ratio", weights_blocks, 0.0) if _style(
             t, "min_distance_ratio", weights_blocks, 0.0) > 0.0 else np.inf),

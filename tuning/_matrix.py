@@ -165,12 +165,14 @@ def run_matrix(presets_dir: str | Path, names=None, runs: int = RUNS, terrains=N
             continue
         creature = spec["creature"]
         preset = load_preset(path, creature)
-        targets = load_tune_targets(None, creature)
+        # A style preset's cells are measured against its own targets (its clearance bound decides
+        # which touch-downs are near a box), the defaults too.
+        targets = load_tune_targets(_repo_path(spec["style"]) if "style" in spec else None, creature)
         style = style_of(name)
         cells = {}
         for terrain in terrains:
             setup = cell_setup(creature, terrain, runs)
-            key = (creature, terrain)
+            key = (creature, terrain, spec.get("style"))
             if key not in defaults:
                 say(f"{creature} defaults on {terrain}")
                 defaults[key] = event_metrics(setup, ScoringWeights(), targets.timing(), targets, map_tasks)

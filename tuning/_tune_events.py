@@ -49,6 +49,9 @@ CHECKPOINT_VERSION = 1
 TAU = 0.01
 """Temperature of the soft selection (:mod:`tuning._proxies`, 'Temperature')."""
 HARVEST_SPAWN = 0.3
+OFFSET_WEIGHT_STYLE = 0.0
+"""The offset block's weight in a style tune: off, the style's blocks lead (with it, every style
+tune first pulled the feet onto the preferred footprints, beside boxes too: collisions rose)."""
 GAIN_NOISE_SE = 2.0
 DEFAULT_SCENARIOS = ("stairs", "crates", "hills", "mixed")
 HELDOUT = {
@@ -150,7 +153,8 @@ def _fit_round(config: EventTuneConfig, params: dict, round_index: int, targets,
                                  timing=timing, max_situations=config.max_situations, map_tasks=map_tasks)
     situations = situations_from_harvest(harvest)
     problem = make_problem(situations, harvest.creatures, {harvest.creatures[0]: targets}, config.tau,
-                           weights_blocks=True, fit_timing=False)
+                           weights_blocks=True, fit_timing=False, offset_weight=OFFSET_WEIGHT_STYLE if targets.style
+                           else 1.0)
     f, k, s = (int(x) for x in situations.couple_mask.shape)
     problem = _pad_problem(problem, _bucket(f, 128), _bucket(k, 32), _bucket(s, 4))
     loss0 = float(loss(initial_params(problem), problem))
