@@ -51,11 +51,11 @@ whatever the number of situations:
     error is the offsets' difference: small offsets, small per-stride errors (always active);
   - touch-down slope, per situation: relu(E[slope] / max_touchdown_slope - 1) (a style's ceiling;
     off without one);
-  - detour, per situation: relu(E[path length / straight distance] min_distance_ratio - 1) (a style's
+  - detour, per situation: relu(log(E[path length / straight distance] min_distance_ratio)) (a style's
     minimum distance ratio: a swing's detour makes the body walk less of what was asked; off without);
   - touch-down clearance, per situation: relu(1 - E[min(obstacle distance, c)] / c), c = the style's
     minimum clearance (body heights x h): footprints kept away from forbidden boxes (off without one);
-  - curvature p95, per situation: relu(E[E] / curvature_p95_max - 1): situations above a style's
+  - curvature p95, per situation: relu(log(E[E] / curvature_p95_max)): situations above a style's
     ceiling (the per-situation hinge stands for the 95th percentile of the runs; off without one).
 
 * prior: (y - y_0) / PRIOR_LOG_SCALE, so that parameters no target constrains stay at
@@ -114,12 +114,14 @@ class FitProblem(eqx.Module):
     detour_max: jax.Array  # (F,) 1 / the style's minimum distance ratio (inf: none)
     curvature_p95_max: jax.Array  # (F,) the style's curvature p95 ceiling (inf: none)
     touchdown_clearance_m: jax.Array  # (F,) the style's minimum clearance to forbidden boxes (m; 0: none)
+    prior_log_scale: jax.Array = PRIOR_LOG_SCALE  # () the prior's scale (module docstring)
     fit_timing: bool = eqx.field(static=True, default=True)
 
 
 def make_problem(situations: Situations, creature_names, targets, tau: float, jerk_weight: float = 0.0,
                  stride_correction=None, duty_correction=None, weights_blocks: bool = False,
-                 fit_timing: bool = True, offset_weight: float = 1.0) -> FitProblem:
+                 fit_timing: bool = True, offset_weight: float = 1.0,
+                 prior_log_scale: float = PRIOR_LOG_SCALE) -> FitProblem:
     """``creature_names``: the harvest's ``creatures`` (``situations.creature`` indexes it);
     ``targets``: :func:`tuning.load_targets` output holding those creatures; ``jerk_weight``:
     weight of the jerk block (0: off, the default; module docstring); ``stride_correction``:
@@ -177,7 +179,7 @@ def make_problem(situations: Situations, creature_names, targets, tau: float, je
         curvature_p95_max=col(lambda t: _style(t, "curvature_p95_max", weights_blocks)),
         touchdown_clearance_m=col(lambda t: _style(t, "min_clearance_body_heights", weights_blocks, 0.0)
                                   * t.leg_length_m),
-        fit_timing=bool(fit_timing))
+        prior_log_scale=jnp.asarray(float(prior_log_scale), dtype=jnp.float64), fit_timing=bool(fit_timing))
 
 
 def _style(target, key: str, on: bool, none: float = np.inf) -> float:
@@ -189,6 +191,11 @@ def _style(target, key: str, on: bool, none: float = np.inf) -> float:
 def timing_vector(log_timing, timing0):
     """Full GaitTiming vector: the fitted fields from ``log_timing``, the others from ``timing0``."""
     return jnp.asarray(timing0).at[_FITTED_INDEX].set(jnp.exp(log_timing))
+
+
+def _log(x):
+    """log x, floored at 1e-300 (a straight path's curvature is 0 or 1e-27) with finite gradients."""
+    return jnp.log(jnp.maximum(x, 1e-300))
 
 
 def _block(values, mask):
@@ -237,10 +244,12 @@ def residuals(params, problem: FitProblem):
     slope_on = jnp.isfinite(problem.slope_max)
     slope_hinge = jax.nn.relu(m["touchdown_slope_rad"] / jnp.where(slope_on, problem.slope_max, 1.0) - 1.0)
     detour_on = jnp.isfinite(problem.detour_max)
-    detour = jax.nn.relu(m["detour_ratio"] / jnp.where(detour_on, problem.detour_max, 1.0) - 1.0)
+    # Log ratios (as the exact run losses, tuning._events): a few detours around a crate are 10x the
+    # straight distance, and a linear hinge squared let them dominate the fit.
+    detour = jax.nn.relu(_log(m["detour_ratio"]) - jnp.log(jnp.where(detour_on, problem.detour_max, 1.0)))
     td_hinge = jax.nn.relu(1.0 - td / jnp.where(td_on, problem.touchdown_clearance_m, 1.0))
     curv_on = jnp.isfinite(problem.curvature_p95_max)
-    curv = jax.nn.relu(m["curvature_energy"] / jnp.where(curv_on, problem.curvature_p95_max, 1.0) - 1.0)
+    curv = jax.nn.relu(_log(m["curvature_energy"]) - jnp.log(jnp.where(curv_on, problem.curvature_p95_max, 1.0)))
     return jnp.concatenate([
         _block(jnp.where(problem.stride_mask, stride, 0.0), problem.stride_mask),
         _block(duty_out, problem.duty_mask),
@@ -253,8 +262,8 @@ def residuals(params, problem: FitProblem):
         _block(detour, detour_on),
         _block(td_hinge, td_on),
         _block(curv, curv_on),
-        (log_weights - problem.log_weights0) / PRIOR_LOG_SCALE,
-        (log_timing - problem.log_timing0) / PRIOR_LOG_SCALE,
+        (log_weights - problem.log_weights0) / problem.prior_log_scale,
+        (log_timing - problem.log_timing0) / problem.prior_log_scale,
     ])
 
 

@@ -49,6 +49,9 @@ CHECKPOINT_VERSION = 1
 TAU = 0.01
 """Temperature of the soft selection (:mod:`tuning._proxies`, 'Temperature')."""
 HARVEST_SPAWN = 0.3
+PRIOR_LOG_SCALE = 2.0
+"""The fit's prior on the log weights (:mod:`tuning._fit`): a factor e^2 costs one tolerance. Looser
+than the timing tune's 1.0: the exact line search has the last word on every step."""
 OFFSET_WEIGHT_STYLE = 0.0
 """The offset block's weight in a style tune: off, the style's blocks lead (with it, every style
 tune first pulled the feet onto the preferred footprints, beside boxes too: collisions rose)."""
@@ -94,6 +97,7 @@ class EventTuneConfig:
     holdout_scenarios: tuple[str, ...] | None = None  # None: heldout_variant of each scenario
     holdout_seeds: tuple[int, ...] = (101, 102, 103)
     gain_noise_se: float = GAIN_NOISE_SE
+    prior_log_scale: float = PRIOR_LOG_SCALE
 
     def __post_init__(self) -> None:
         for name in ("scenarios", "seeds", "spawn_fractions", "holdout_seeds"):
@@ -154,7 +158,7 @@ def _fit_round(config: EventTuneConfig, params: dict, round_index: int, targets,
     situations = situations_from_harvest(harvest)
     problem = make_problem(situations, harvest.creatures, {harvest.creatures[0]: targets}, config.tau,
                            weights_blocks=True, fit_timing=False, offset_weight=OFFSET_WEIGHT_STYLE if targets.style
-                           else 1.0)
+                           else 1.0, prior_log_scale=config.prior_log_scale)
     f, k, s = (int(x) for x in situations.couple_mask.shape)
     problem = _pad_problem(problem, _bucket(f, 128), _bucket(k, 32), _bucket(s, 4))
     loss0 = float(loss(initial_params(problem), problem))
