@@ -750,8 +750,8 @@ def matrix_table(matrix: dict) -> Table:
         table.add_column(t, justify="right")
     table.add_column("passes")
     for name, p in matrix["presets"].items():
-        if not p["found"]:
-            table.add_row(name, *["-"] * len(terrains), "not found")
+        if not p["found"] or not p["cells"]:
+            table.add_row(name, *["-"] * len(terrains), "no: " + "; ".join(p["why"]))
             continue
         row = []
         for t in terrains:

@@ -229,7 +229,7 @@ def matrix_section(matrix: dict | None) -> str:
     for name, p in matrix["presets"].items():
         cells = []
         for t in terrains:
-            if not p.get("found"):
+            if not p.get("found") or t not in p["cells"]:
                 cells.append("<td>-</td>")
                 continue
             c = p["cells"][t]

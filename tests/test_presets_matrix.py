@@ -36,8 +36,10 @@ def test_the_matrix_proves_every_preset_with_enough_paired_runs():
     assert m["runs_per_cell"] >= RUNS >= 30
     assert set(m["presets"]) == set(PRESETS) and set(m["terrains"]) == set(TERRAINS)
     for name, p in m["presets"].items():
-        if not p["found"]:
+        if not p["found"] or not p["cells"]:  # not there, or its tune kept the defaults (why says so)
+            assert not p["passes"] and p["why"]
             continue
+        assert set(p["cells"]) == set(TERRAINS)
         for terrain, cell in p["cells"].items():
             assert cell["main"]["n"] >= 0.8 * m["runs_per_cell"], (name, terrain)  # runs with >= 3 strides
 

@@ -328,3 +328,24 @@ def test_a_style_preset_passes_when_its_metric_moves_toward_its_bound():
     assert verdict("spider-cautious", good, style) == (True, [])
     bad = {t: evaluate_cell(default, down, style) for t in ("crates", "mixed")}
     assert not verdict("spider-cautious", bad, style)[0]
+
+
+def test_the_reports_matrix_section_shows_every_preset_its_cells_and_verdict():
+    from reports._html import matrix_section
+    from tuning._matrix import evaluate_cell, verdict
+
+    rng = np.random.default_rng(2)
+    base = 0.1 + 0.01 * rng.standard_normal(30)
+    cell = evaluate_cell(_events(base), _events(base - 0.02), {})
+    passes, why = verdict("spider-stairs", {"stairs": cell}, {})
+    matrix = {"terrains": {"stairs": "stairs@terrain.rise=0.1,terrain.run=0.3"}, "runs_per_cell": 30, "win_se": 2.0,
+              "loss_se": 1.0, "presets": {
+                  "spider-stairs": {"found": True, "passes": passes, "why": why, "command": "footfall tune X",
+                                    "cells": {"stairs": cell}},
+                  "ant-crates": {"found": False, "passes": False, "why": ["kept the defaults"],
+                                 "command": "footfall tune Y"}}}
+    page = matrix_section(matrix)
+    assert "spider-stairs" in page and "ant-crates" in page and "kept the defaults" in page
+    assert f"{cell['main']['default']:.3f} &rarr; {cell['main']['preset']:.3f}" in page
+    assert "footfall tune X" in page and "stairs@terrain.rise=0.1,terrain.run=0.3" in page
+    assert "No matrix stored" in matrix_section(None)

@@ -51,7 +51,8 @@ SPAWNS = (0.15, 0.3, 0.45)
 
 PRESETS = {
     "spider-stairs": {"creature": "spider", "terrain": "stairs",
-                      "command": "footfall tune --creature spider --scenarios stairs --out tuning/data/presets/spider-stairs.json"},
+                      "command": "footfall tune --creature spider --scenarios stairs --spearman-candidates 20 "
+                                 "--out tuning/data/presets/spider-stairs.json"},
     "quadruped-stairs": {"creature": "quadruped", "terrain": "stairs",
                          "command": "footfall tune --creature quadruped --scenarios stairs "
                                     "--out tuning/data/presets/quadruped-stairs.json"},
@@ -165,6 +166,17 @@ def run_matrix(presets_dir: str | Path, names=None, runs: int = RUNS, terrains=N
             continue
         creature = spec["creature"]
         preset = load_preset(path, creature)
+        if preset.weights == ScoringWeights() and (preset.timing is None or preset.timing == load_tune_targets(
+                _repo_path(spec["style"]) if "style" in spec else None, creature).timing()):
+            # Its tune accepted no candidate: the defaults against themselves would prove nothing.
+            rounds = preset.provenance.get("rounds", [])
+            last = rounds[-1]["line_search"] if rounds else []
+            out["presets"][name] = {
+                "found": True, "creature": creature, "kind": "terrain" if "terrain" in spec else "style",
+                "passes": False, "command": spec["command"], "weights_max_rel_change": 0.0, "cells": {},
+                "why": ["its tune kept the defaults: " + "; ".join(f"step x{t['alpha']:g}: {t['decision']}"
+                                                                 for t in last)]}
+            continue
         # A style preset's cells are measured against its own targets (its clearance bound decides
         # which touch-downs are near a box), the defaults too.
         targets = load_tune_targets(_repo_path(spec["style"]) if "style" in spec else None, creature)

@@ -33,6 +33,9 @@ PAIRS = (
     ("curvature_energy", "curvature_p95", 1.0),
 )
 """(proxy metric, run metric, sign): the run metric is expected to move as sign x the proxy's."""
+UNMOVED = {"curvature_p95": 1e-9}
+"""Run metrics whose changes below this are no change: a straight swing's curvature energy is 0 or
+1e-27 (rounding), and ranking rounding noise says nothing about the proxies."""
 
 
 def candidate_weights(n: int, seed: int) -> list[np.ndarray]:
@@ -94,7 +97,7 @@ def metric_change_spearman(config, targets, n: int, map_tasks=None) -> dict:
     for pk, ek, _ in PAIRS:
         x, y = np.asarray(predicted[pk]), np.asarray(measured[ek])
         keep = np.isfinite(x) & np.isfinite(y)
-        if keep.sum() < 3 or np.ptp(x[keep]) == 0.0 or np.ptp(y[keep]) == 0.0:
+        if keep.sum() < 3 or np.ptp(x[keep]) == 0.0 or np.abs(y[keep]).max() <= UNMOVED.get(ek, 0.0):
             rho[ek] = None  # a metric the candidates do not move (e.g. no curvature on stairs)
         else:
             rho[ek] = float(spearmanr(x[keep], y[keep]).statistic)
