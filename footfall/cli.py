@@ -672,19 +672,27 @@ def bench_tuning_cmd(
     max_evals: int = typer.Option(150, "--max-evals", min=1, help="CMA-ES budget of exact-planner evaluations"),
     rounds: int = typer.Option(2, min=1, help="Outer rounds of the optimistix tune at most"),
     seed: int = typer.Option(0, min=0, help="Seed of the tune and of CMA-ES"),
+    scenarios: Optional[str] = typer.Option(None, "--scenarios", help="Compare on a terrain tune of the weights "
+                                            "(A,B,...; footfall tune --scenarios) instead of the timing tune"),
     json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),
 ) -> None:
     """Optimistix on the JAX proxies vs CMA-ES on the exact planner.
 
     Wall time and exact evaluations to reach the same exact loss.
     """
-    from benchmarks.tuning_bench import run, table
+    from benchmarks.tuning_bench import run, run_events, table
     from tuning._tune import check_creature
 
     check_creature(creature)
     with _err().status("benchmarking the tuning...") as status:
-        result = run(creature, seed=seed, max_evals=max_evals, rounds=rounds,
-                     progress=lambda m: status.update(f"benchmarking: {m}"))
+        if scenarios is not None:
+            from tuning._tune_events import check_scenarios
+
+            result = run_events(creature, check_scenarios(scenarios.split(",")), seed=seed, max_evals=max_evals,
+                                rounds=max(rounds, 1), progress=lambda m: status.update(f"benchmarking: {m}"))
+        else:
+            result = run(creature, seed=seed, max_evals=max_evals, rounds=rounds,
+                         progress=lambda m: status.update(f"benchmarking: {m}"))
     if json_out:
         print(json.dumps(result))
         return

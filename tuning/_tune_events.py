@@ -229,10 +229,11 @@ def weights_max_rel_change(tuned: dict, default: dict) -> float:
 
 def tune_events(config: EventTuneConfig, out, resume: bool = False, progress=None, stop_after: int | None = None,
                 write: bool = True, workers: int | None = None, cluster: str | None = None,
-                spearman_candidates: int = 0) -> TuneResult:
+                spearman_candidates: int = 0, evaluate: bool = True) -> TuneResult:
     """Run (or resume) the terrain / style tune; write the preset to ``out`` (module docstring).
     ``spearman_candidates`` > 0: also validate the proxies on that many candidate presets
-    (:func:`tuning._validate.metric_change_spearman`)."""
+    (:func:`tuning._validate.metric_change_spearman`). ``evaluate`` False: stop after the outer loop
+    (the checkpoint holds the result; ``footfall bench tuning --scenarios`` times the search alone)."""
     from footfall._distribute import check_workers, task_runner
 
     t0 = time.perf_counter()
@@ -240,10 +241,11 @@ def tune_events(config: EventTuneConfig, out, resume: bool = False, progress=Non
     check_creature(config.creature)
     out = check_output(out)
     with task_runner(workers, cluster) as map_tasks:
-        return _run(config, out, resume, progress, stop_after, write, map_tasks, t0, spearman_candidates)
+        return _run(config, out, resume, progress, stop_after, write, map_tasks, t0, spearman_candidates, evaluate)
 
 
-def _run(config, out, resume, progress, stop_after, write, map_tasks, t0, spearman_candidates) -> TuneResult:
+def _run(config, out, resume, progress, stop_after, write, map_tasks, t0, spearman_candidates,
+         evaluate=True) -> TuneResult:
     from planner._presets import preset_dict
     from scenarios import default_gait_name, load_creature
     from tuning._config import enable_x64
@@ -293,6 +295,8 @@ def _run(config, out, resume, progress, stop_after, write, map_tasks, t0, spearm
         _save(ckpt, state)
         if stop_after is not None and state["round"] >= stop_after:
             return TuneResult(preset={}, summary={}, wall_s=time.perf_counter() - t0, finished=False)
+    if not evaluate:
+        return TuneResult(preset={}, summary={}, wall_s=time.perf_counter() - t0, finished=True)
     say("held-out runs", total - 1, total)
     best = state["best"]
     holdout = config.holdout()
