@@ -759,7 +759,7 @@ def matrix_table(matrix: dict) -> Table:
     table.add_column("passes")
     for name, p in matrix["presets"].items():
         if not p["found"] or not p["cells"]:
-            table.add_row(name, *["-"] * len(terrains), "no: " + "; ".join(p["why"]))
+            table.add_row(name, *["-"] * len(terrains), "no: " + p["why"][0][:120])
             continue
         row = []
         for t in terrains:
@@ -771,7 +771,7 @@ def matrix_table(matrix: dict) -> Table:
                 if s["gain_se"] is not None:
                     text += f"\n{s['metric']} {s['default']:.3g}->{s['preset']:.3g} ({s['gain_se']:+.1f})"
             row.append(text)
-        table.add_row(name, *row, "yes" if p["passes"] else "no: " + "; ".join(p["why"]))
+        table.add_row(name, *row, "yes" if p["passes"] else "no: " + p["why"][0][:120])
     return table
 
 
