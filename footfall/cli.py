@@ -569,6 +569,8 @@ def tune_cmd(
         None, "--start-timing", help="Start the search from a mis-tuned gait timing, FIELD=VALUE of GaitTiming "
         "(repeatable, e.g. stride_coefficient=3.0); the summary adds the *_start figures"),
     characters: int = typer.Option(1, "--characters", min=1, help="With --scenarios/--targets: characters per run"),
+    seeds: int = typer.Option(3, "--seeds", min=1, help="With --scenarios/--targets: crowd seeds per scenario and "
+                              "spawn (the training and the held-out runs)"),
     frames: int = typer.Option(300, "--frames", min=60, help="With --scenarios/--targets: frames per run (each "
                                "scenario is run from spawns along its route)"),
     spearman_candidates: int = typer.Option(
@@ -607,7 +609,9 @@ meet the terrain, checked on held-out variants (a terrain or style preset).
         load_tune_targets(targets, creature)  # a malformed file: one line, before any work
         names = check_scenarios(scenarios.split(",")) if scenarios is not None else DEFAULT_SCENARIOS
         config = EventTuneConfig(creature, scenarios=names, targets_file=targets, seed=seed, characters=characters,
-                                 frames=frames, **({} if rounds is None else {"rounds": rounds}))
+                                 frames=frames, seeds=tuple(range(seeds)),
+                                 holdout_seeds=tuple(range(101, 101 + seeds)),
+                                 **({} if rounds is None else {"rounds": rounds}))
     else:
         config = TuneConfig(creature, rounds=rounds or 2, seed=seed,
                             start_timing=_field_values(start_timing, "--start-timing"))
@@ -703,7 +707,8 @@ def bench_tuning_cmd(
 def bench_presets_cmd(
     presets_dir: str = typer.Option("tuning/data/presets", "--presets-dir", help="Folder of the presets NAME.json"),
     names: Optional[str] = typer.Option(None, "--presets", help="Presets to prove, A,B,... (default: every terrain "
-                                        "and style preset of tuning._matrix.PRESETS)"),
+                                        "and style preset of tuning._matrix.PRESETS); with --out an existing "
+                                        "matrix keeps the others' entries"),
     runs: int = typer.Option(30, "--runs", min=2, help="Paired runs per preset x terrain cell"),
     out: Optional[str] = typer.Option(None, "--out", help="Write the matrix here (.json), e.g. tuning/data/matrix.json"),
     prune: bool = typer.Option(False, "--prune", help="Delete from --presets-dir the presets that do not pass (only "
@@ -732,6 +737,14 @@ elsewhere; a style preset with its style metric >= 2 SE toward its bound; neithe
         matrix = run_matrix(presets_dir, chosen, runs=runs, map_tasks=map_tasks,
                             progress=lambda m: status.update(f"proving the presets: {m}"))
     if out is not None:
+        from pathlib import Path
+
+        if names and Path(out).exists():
+            # Some presets re-proved: their entries replace those of the stored matrix (same terrains and runs).
+            stored = json.loads(Path(out).read_text())
+            same = all(stored.get(k) == matrix[k] for k in ("terrains", "runs_per_cell", "seed_base", "spawns"))
+            if same:
+                matrix = {**stored, "presets": {**stored["presets"], **matrix["presets"]}}
         write_text_atomic(out, json.dumps(matrix, indent=1, allow_nan=False) + "\n")
     if prune:
         from pathlib import Path
