@@ -325,3 +325,95 @@ def table(result: dict):
     table.add_row("CMA-ES (exact)", f"{cmaes['wall_s']:.1f}", str(cmaes["exact_evals"]),
                   f"{cmaes['exact_loss']:.4g}", "yes" if cmaes["reached"] else "no")
     return table
+
+
+# --------------------------------------------------------------------------- terrain / style tunes (issue 18)
+
+
+def run_events(creature: str, scenarios, seed: int = 0, max_evals: int = DEFAULT_MAX_EVALS, rounds: int = 3,
+               progress=None, config_overrides: dict | None = None) -> dict:
+    """The same comparison for the weights of a terrain tune (``footfall bench tuning --scenarios``):
+
+    * **proxy** -- :func:`tuning._tune_events.tune_events` without its held-out runs, in this process;
+      exact evaluations = 1 (the defaults) + every line-search entry; its result is the best accepted
+      loss (the mean paired run loss of :mod:`tuning._events` over the tune's runs);
+    * **cmaes** -- seeded CMA-ES on x = log of the 19 ``ScoringWeights`` from the defaults (the timing
+      is the targets' stride law, as in the tune), sigma0 :data:`SIGMA0`, on the same runs' mean loss,
+      until a candidate reaches the proxy's loss or ``max_evals``.
+
+    The tune's acceptance guards stay on (collisions, noise): the comparison is to the loss of the
+    preset the tune writes. One untimed evaluation of the defaults warms the planner first."""
+    import cma
+
+    from planner._weights import ScoringWeights
+    from tuning._config import enable_x64
+    from tuning._events import event_metrics
+    from tuning._targets import load_tune_targets
+    from tuning._tune_events import EventTuneConfig, checkpoint_path, tune_events
+
+    import json
+
+    max_evals = _check_int("max_evals", max_evals, 1)
+    config = EventTuneConfig(creature, scenarios=tuple(scenarios), rounds=rounds, seed=seed,
+                             **dict(config_overrides or {}))
+    enable_x64()
+    targets = load_tune_targets(config.targets_file, creature)
+    setup = config.setup()
+    timing = targets.timing()
+    say = progress or (lambda message: None)
+    say("warming up the exact planner")
+    event_metrics(setup, ScoringWeights(), timing, targets)
+    with tempfile.TemporaryDirectory(prefix="footfall-bench-tuning-") as folder:
+        out = Path(folder) / f"bench-{creature}.json"
+        t0 = time.perf_counter()
+        tune_events(config, out, workers=1, evaluate=False,
+                    progress=lambda message, *_: say(f"optimistix: {message}"))
+        proxy_wall = time.perf_counter() - t0
+        state = json.loads(checkpoint_path(out).read_text())
+    line_search = [len(r["line_search"]) for r in state["history"]]
+    target = float(state["best"]["exact"]["exact_loss"])
+    proxy = {"wall_s": float(proxy_wall), "exact_evals": 1 + sum(line_search), "exact_loss": target,
+             "start_exact_loss": float(state["default_exact"]["exact_loss"]), "rounds_run": len(line_search),
+             "accepted_rounds": sum(bool(r["accepted"]) for r in state["history"])}
+    x0 = np.log(ScoringWeights().to_array())
+    rng = np.random.default_rng(config.seed)
+    es = cma.CMAEvolutionStrategy(x0, SIGMA0, {"seed": np.nan, "randn": lambda *shape: rng.standard_normal(shape),
+                                               "verbose": -9, "verb_log": 0, "verb_disp": 0})
+    history: list[float] = []
+    stopped_by = "max_evals"
+    t0 = time.perf_counter()
+    while len(history) < max_evals:
+        if es.stop():
+            stopped_by = "cma: " + ", ".join(sorted(es.stop()))
+            break
+        candidates = es.ask()
+        losses = []
+        for x in candidates:
+            try:
+                loss = float(event_metrics(setup, ScoringWeights.from_array(np.exp(x)), timing, targets)["exact_loss"])
+            except ValueError:
+                loss = INVALID_LOSS
+            history.append(loss)
+            losses.append(loss)
+            say(f"CMA-ES {len(history)}/{max_evals}: best {min(history):.4g} (target {target:.4g})")
+            if loss <= target or len(history) >= max_evals:
+                break
+        if history[-1] <= target:
+            stopped_by = "target"
+            break
+        if len(losses) == len(candidates):
+            es.tell(candidates, losses)
+    wall = time.perf_counter() - t0
+    best = min(history)
+    cmaes = {"wall_s": float(wall), "exact_evals": len(history), "exact_loss": float(best),
+             "reached": bool(best <= target), "stopped_by": stopped_by, "popsize": int(es.popsize),
+             "sigma0": SIGMA0, "dimension": int(x0.size), "history": [float(v) for v in history]}
+    return {"creature": creature, "scenarios": list(config.scenarios), "seed": config.seed, "rounds": rounds,
+            "max_evals": max_evals, "target_loss": target, "proxy": proxy, "cmaes": cmaes,
+            "speedup": float(wall / max(proxy_wall, 1e-9)),
+            "evals_ratio": float(len(history) / proxy["exact_evals"]),
+            "reached": cmaes["reached"], "speedup_is_lower_bound": not cmaes["reached"],
+            "exact_setup": setup.to_json(),
+            "notes": "terrain tune of the weights (tuning._tune_events); losses: mean paired run loss over the "
+                     "tune's runs" + ("." if cmaes["reached"] else
+                                      f"; CMA-ES did not reach it in {max_evals} evaluations: lower bounds.")}

@@ -552,20 +552,41 @@ def _field_values(items: Optional[list[str]], option: str) -> tuple[tuple[str, f
 @app.command("tune")
 def tune_cmd(
     creature: str = typer.Option(..., "--creature", help="Creature to tune: built-in name or .toml"),
+    scenarios: Optional[str] = typer.Option(
+        None, "--scenarios", help="Tune the scoring weights for these terrains, A,B,... (built-in names, files or "
+        "variants such as stairs@terrain.rise=0.1); runs spawn along each route and meet its feature"),
+    targets: Optional[str] = typer.Option(
+        None, "--targets", help="Targets .toml: the stride law, duty-factor bands and a style (tuning/_targets.py "
+        "and tuning/data/styles/ for examples); with it, the weights are tuned (on stairs, crates, hills, mixed "
+        "unless --scenarios says)"),
     out: Optional[str] = typer.Option(None, "--out", help="Preset file (.json; default out/presets/NAME.json); "
                                       "the checkpoint is written beside it"),
     resume: bool = typer.Option(False, "--resume", help="Continue a killed run from its checkpoint"),
-    rounds: int = typer.Option(2, "--rounds", help="Outer rounds at most (harvest, fit, exact loss)"),
+    rounds: Optional[int] = typer.Option(None, "--rounds", help="Outer rounds at most (harvest, fit, exact runs; "
+                                         "default 2, 3 with --scenarios/--targets)"),
     seed: int = typer.Option(0, "--seed", help="Seed of the harvests and runs (same seed, same preset)"),
     start_timing: Optional[list[str]] = typer.Option(
         None, "--start-timing", help="Start the search from a mis-tuned gait timing, FIELD=VALUE of GaitTiming "
         "(repeatable, e.g. stride_coefficient=3.0); the summary adds the *_start figures"),
+    characters: int = typer.Option(1, "--characters", min=1, help="With --scenarios/--targets: characters per run"),
+    seeds: int = typer.Option(3, "--seeds", min=1, help="With --scenarios/--targets: crowd seeds per scenario and "
+                              "spawn (the training and the held-out runs)"),
+    frames: int = typer.Option(300, "--frames", min=60, help="With --scenarios/--targets: frames per run (each "
+                               "scenario is run from spawns along its route)"),
+    spearman_candidates: int = typer.Option(
+        0, "--spearman-candidates", min=0, help="With --scenarios/--targets: validate the proxies on this many "
+        "candidate presets (>= 20 for the issue's check; costs as many exact evaluations)"),
     cluster: Optional[str] = typer.Option(None, help="Dask scheduler address (tcp://host:8786) to run the harvests "
                                           "and exact runs on"),
     workers: Optional[int] = typer.Option(None, help="Local worker processes (default: one per core; 1: in-process)"),
     json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),
 ) -> None:
-    """Tune a creature's scoring weights and gait timing against the biomechanics targets and write a preset."""
+    """Tune a creature against its targets and write a preset.
+
+    Without --scenarios and --targets: the gait timing against the stride law on a sweep of speeds (the \
+generic preset). With either: the scoring weights for those terrains and that style, on runs that \
+meet the terrain, checked on held-out variants (a terrain or style preset).
+    """
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
     from footfall._distribute import check_workers
@@ -576,14 +597,37 @@ def tune_cmd(
     check_workers(workers, cluster)
     check_creature(creature)
     path = check_output(out or f"out/presets/{load_creature(creature).name}.json")
-    config = TuneConfig(creature, rounds=rounds, seed=seed, start_timing=_field_values(start_timing, "--start-timing"))
+    if rounds is not None and rounds < 1:
+        raise InputError("argument", "--rounds", f"expected an integer >= 1, got {rounds}")
+    events = scenarios is not None or targets is not None
+    if events:
+        from tuning._targets import load_tune_targets
+        from tuning._tune_events import DEFAULT_SCENARIOS, EventTuneConfig, check_scenarios, tune_events
+
+        if start_timing:
+            raise InputError("argument", "--start-timing", "tunes the timing; --scenarios/--targets tune the weights")
+        load_tune_targets(targets, creature)  # a malformed file: one line, before any work
+        names = check_scenarios(scenarios.split(",")) if scenarios is not None else DEFAULT_SCENARIOS
+        config = EventTuneConfig(creature, scenarios=names, targets_file=targets, seed=seed, characters=characters,
+                                 frames=frames, seeds=tuple(range(seeds)),
+                                 holdout_seeds=tuple(range(101, 101 + seeds)),
+                                 **({} if rounds is None else {"rounds": rounds}))
+    else:
+        config = TuneConfig(creature, rounds=rounds or 2, seed=seed,
+                            start_timing=_field_values(start_timing, "--start-timing"))
     bar = Progress(TextColumn("tune"), BarColumn(), TextColumn("{task.description}"), TimeElapsedColumn(),
                    console=_err(), transient=True, disable=not _err().is_terminal)
     with bar:
         task = bar.add_task("starting", total=config.rounds + 2)
-        result = tune(config, path, resume=resume, workers=workers, cluster=cluster,
-                      progress=lambda what, done, total: bar.update(task, description=what, completed=done,
-                                                                    total=total))
+
+        def said(what, done, total):
+            bar.update(task, description=what, completed=done, total=total)
+
+        if events:
+            result = tune_events(config, path, resume=resume, workers=workers, cluster=cluster, progress=said,
+                                 spearman_candidates=spearman_candidates)
+        else:
+            result = tune(config, path, resume=resume, workers=workers, cluster=cluster, progress=said)
     summary = dict(result.summary, wall_s=result.wall_s, preset=str(path))
     if json_out:
         print(json.dumps(summary))
@@ -592,6 +636,9 @@ def tune_cmd(
     table.add_column("metric")
     table.add_column("value", justify="right")
     for key, value in summary.items():
+        if key == "targets":
+            value = f"{value['file']} (stride law {value['stride_length']['coefficient']:g} h Fr^" \
+                    f"{value['stride_length']['exponent']:g}; style {value['style'] or 'none'})"
         table.add_row(key, f"{value:.4g}" if isinstance(value, float) else str(value))
     _stdout().print(table)
 
@@ -634,23 +681,116 @@ def bench_tuning_cmd(
     max_evals: int = typer.Option(150, "--max-evals", min=1, help="CMA-ES budget of exact-planner evaluations"),
     rounds: int = typer.Option(2, min=1, help="Outer rounds of the optimistix tune at most"),
     seed: int = typer.Option(0, min=0, help="Seed of the tune and of CMA-ES"),
+    scenarios: Optional[str] = typer.Option(None, "--scenarios", help="Compare on a terrain tune of the weights "
+                                            "(A,B,...; footfall tune --scenarios) instead of the timing tune"),
     json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),
 ) -> None:
     """Optimistix on the JAX proxies vs CMA-ES on the exact planner.
 
     Wall time and exact evaluations to reach the same exact loss.
     """
-    from benchmarks.tuning_bench import run, table
+    from benchmarks.tuning_bench import run, run_events, table
     from tuning._tune import check_creature
 
     check_creature(creature)
     with _err().status("benchmarking the tuning...") as status:
-        result = run(creature, seed=seed, max_evals=max_evals, rounds=rounds,
-                     progress=lambda m: status.update(f"benchmarking: {m}"))
+        if scenarios is not None:
+            from tuning._tune_events import check_scenarios
+
+            result = run_events(creature, check_scenarios(scenarios.split(",")), seed=seed, max_evals=max_evals,
+                                rounds=max(rounds, 1), progress=lambda m: status.update(f"benchmarking: {m}"))
+        else:
+            result = run(creature, seed=seed, max_evals=max_evals, rounds=rounds,
+                         progress=lambda m: status.update(f"benchmarking: {m}"))
     if json_out:
         print(json.dumps(result))
         return
     _stdout().print(table(result))
+
+
+@bench_app.command("presets")
+def bench_presets_cmd(
+    presets_dir: str = typer.Option("tuning/data/presets", "--presets-dir", help="Folder of the presets NAME.json"),
+    names: Optional[str] = typer.Option(None, "--presets", help="Presets to prove, A,B,... (default: every terrain "
+                                        "and style preset of tuning._matrix.PRESETS); with --out an existing "
+                                        "matrix keeps the others' entries"),
+    runs: int = typer.Option(30, "--runs", min=2, help="Paired runs per preset x terrain cell"),
+    out: Optional[str] = typer.Option(None, "--out", help="Write the matrix here (.json), e.g. tuning/data/matrix.json"),
+    prune: bool = typer.Option(False, "--prune", help="Delete from --presets-dir the presets that do not pass (only "
+                               "a passing preset ships)"),
+    cluster: Optional[str] = typer.Option(None, help="Dask scheduler address to run the runs on"),
+    workers: Optional[int] = typer.Option(None, help="Local worker processes (default: one per core; 1: in-process)"),
+    json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),
+) -> None:
+    """The terrain and style presets against the defaults on held-out terrains: paired runs per cell.
+
+    A terrain preset passes with a per-stride error >= 2 SE better on its terrain and <= 1 SE worse \
+elsewhere; a style preset with its style metric >= 2 SE toward its bound; neither with more collisions.
+    """
+    from footfall._atomic import write_text_atomic
+    from footfall._distribute import check_workers, task_runner
+    from tuning._matrix import PRESETS, run_matrix
+
+    check_workers(workers, cluster)
+    chosen = tuple(n.strip() for n in names.split(",") if n.strip()) if names else tuple(PRESETS)
+    for name in chosen:
+        if name not in PRESETS:
+            raise InputError("argument", "--presets", f"unknown preset {name!r}; expected {', '.join(PRESETS)}")
+    if out is not None and not out.endswith(".json"):
+        raise InputError("argument", "--out", f"expected a .json path, got {out!r}")
+    with _err().status("proving the presets...") as status, task_runner(workers, cluster) as map_tasks:
+        matrix = run_matrix(presets_dir, chosen, runs=runs, map_tasks=map_tasks,
+                            progress=lambda m: status.update(f"proving the presets: {m}"))
+    if out is not None:
+        from pathlib import Path
+
+        if names and Path(out).exists():
+            # Some presets re-proved: their entries replace those of the stored matrix (same terrains and runs).
+            stored = json.loads(Path(out).read_text())
+            same = all(stored.get(k) == matrix[k] for k in ("terrains", "runs_per_cell", "seed_base", "spawns"))
+            if same:
+                matrix = {**stored, "presets": {**stored["presets"], **matrix["presets"]}}
+        write_text_atomic(out, json.dumps(matrix, indent=1, allow_nan=False) + "\n")
+    if prune:
+        from pathlib import Path
+
+        for name, p in matrix["presets"].items():
+            if p["found"] and not p["passes"]:
+                (Path(presets_dir) / f"{name}.json").unlink()
+                checkpoint = Path(presets_dir) / f"{name}.json.checkpoint.json"
+                checkpoint.unlink(missing_ok=True)
+                _err().print(f"footfall: note: {name} does not pass; removed from {presets_dir}", markup=False)
+    if json_out:
+        print(json.dumps(matrix))
+        return
+    _stdout().print(matrix_table(matrix))
+
+
+def matrix_table(matrix: dict) -> Table:
+    """The preset x terrain matrix: per cell, the main (or style) metric's gain in SE, default -> preset."""
+    terrains = list(matrix["terrains"])
+    table = Table(title=f"presets vs defaults on held-out terrains ({matrix['runs_per_cell']} paired runs per cell; "
+                  "gain in SE, > 0 = better)")
+    table.add_column("preset")
+    for t in terrains:
+        table.add_column(t, justify="right")
+    table.add_column("passes")
+    for name, p in matrix["presets"].items():
+        if not p["found"] or not p["cells"]:
+            table.add_row(name, *["-"] * len(terrains), "no: " + p["why"][0][:120])
+            continue
+        row = []
+        for t in terrains:
+            cell = p["cells"][t]
+            main = cell["main"]
+            text = (f"{main['default']:.3f}->{main['preset']:.3f} ({main['gain_se']:+.1f})"
+                    if main["default"] is not None and main["gain_se"] is not None else "-")
+            for key, s in cell["style"].items():
+                if s["gain_se"] is not None:
+                    text += f"\n{s['metric']} {s['default']:.3g}->{s['preset']:.3g} ({s['gain_se']:+.1f})"
+            row.append(text)
+        table.add_row(name, *row, "yes" if p["passes"] else "no: " + p["why"][0][:120])
+    return table
 
 
 @bench_app.command("planner")

@@ -2,7 +2,7 @@
 
 * :func:`pareto_plot`: score loss vs planning cost per setting, the budgets' front and
   the recommended budget;
-* :func:`stride_plot`: realised stride length vs speed against lambda = 2.3 h Fr^0.3;
+* :func:`stride_plot`: realised stride length vs speed against the targets' law lambda = c h Fr^e;
 * :func:`gait_disks`: the gait manager's disks (paper Fig. 8);
 * :func:`footprint_heatmap`: candidate footprints and trajectories of one plan (paper Fig. 13);
 * :func:`lod_scaling_plot`: ms per frame against crowd size per LOD mode, with 95 % intervals.
@@ -77,7 +77,7 @@ def pareto_plot(analysis: dict, path) -> None:
 
 def stride_plot(results: list[dict], path) -> None:
     """Every kept (speed, stride) sample, by scenario, and the target curve per hip height."""
-    from reports._sweep import target_stride_length
+    from reports._sweep import stride_law_text, target_stride_length
 
     fig = Figure(figsize=(7.0, 4.8), layout="constrained")
     ax = fig.subplots()
@@ -107,7 +107,7 @@ def stride_plot(results: list[dict], path) -> None:
     v = np.linspace(1e-3, 1.1 * v_max, 200)
     for creature, h in sorted(heights):
         ax.plot(v, target_stride_length(v, h, creature), c="k", lw=1.8,
-                label=f"target 2.3 h Fr^0.3 ({creature}, h = {h:.3f} m)")
+                label=f"target {stride_law_text(creature)} ({creature}, h = {h:.3f} m)")
     ax.set_xlabel("speed v (m/s), pelvis over the stride")
     ax.set_ylabel("stride length λ (m), same foot, one cycle")
     ax.set_title("Stride length vs speed")

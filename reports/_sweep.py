@@ -348,6 +348,14 @@ def curvature_energy(points: np.ndarray, window=CURVATURE_WINDOW) -> float:
     return total * energy
 
 
+def stride_law_text(creature: str = "spider", html: bool = False) -> str:
+    """The creature's target stride law as text, its numbers read from ``tuning/data/targets.toml``
+    (e.g. ``2.3 h Fr^0.3``; ``html``: the exponent as a superscript)."""
+    t = _stride_target(creature)
+    c, e = t["coefficient"], t["exponent"]
+    return f"{c:g} h Fr<sup>{e:g}</sup>" if html else f"{c:g} h Fr^{e:g}"
+
+
 def target_stride_length(speed, hip_height: float, creature: str = "spider"):
     """The biomechanics target lambda = coefficient h Fr^exponent, Fr = v^2 / (g h), m: the
     creature's ``stride_length`` entry of ``tuning/data/targets.toml`` (2.3 h Fr^0.3, Alexander

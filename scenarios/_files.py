@@ -245,12 +245,13 @@ def split_variant(spec: str) -> tuple[str, dict[str, Any]]:
     """``"NAME@key=value,key=value"`` -> (NAME, {dotted key: value}); values are TOML scalars.
 
     A *variant* is a scenario with a few of its file's values replaced, in memory: ``hills@seed=3``
-    (the same kind of terrain from another seed), ``flat@crowd.speed=0.12``. It is a plain string,
-    so a task sent to another machine carries it and loads the same scenario there.
+    (the same kind of terrain from another seed), ``flat@crowd.speed=0.12``, ``stairs@crowd.centre=[-3.0,0.0]``
+    (commas inside brackets belong to the value). It is a plain string, so a task sent to another
+    machine carries it and loads the same scenario there.
     """
     name, _, rest = spec.partition("@")
     overrides: dict[str, Any] = {}
-    for item in filter(None, _split_outside_brackets(rest)):
+    for item in filter(None, _split_top_level(rest)):
         key, eq, value = item.partition("=")
         if not eq or not key.strip():
             raise InputError(spec, "scenario", f"variant {item!r}: expected key=value")
@@ -261,13 +262,19 @@ def split_variant(spec: str) -> tuple[str, dict[str, Any]]:
     return name, overrides
 
 
-def _split_outside_brackets(text: str) -> list[str]:
-    """``text`` split at the commas that are not inside ``[...]`` (a TOML array is one value:
-    ``terrain.size=[60.0,60.0],seed=2`` is two items)."""
-    items, depth, start = [], 0, 0
+def _split_top_level(text: str) -> list[str]:
+    """``text`` split at the commas outside brackets and quotes."""
+    items, depth, quote, start = [], 0, None, 0
     for i, ch in enumerate(text):
-        depth += (ch == "[") - (ch == "]")
-        if ch == "," and depth == 0:
+        if quote:
+            quote = None if ch == quote else quote
+        elif ch in "\"'":
+            quote = ch
+        elif ch in "[{":
+            depth += 1
+        elif ch in "]}":
+            depth -= 1
+        elif ch == "," and depth == 0:
             items.append(text[start:i])
             start = i + 1
     items.append(text[start:])

@@ -157,3 +157,20 @@ def test_invalid_candidate_costs_the_penalty(tiny_setup):
 def test_bad_arguments_name_the_argument(kwargs, name):
     with pytest.raises(ValueError, match=f"^{name}:"):
         tb.run("spider", **kwargs)
+
+
+def test_the_terrain_tune_comparison_counts_both_methods_on_the_same_runs():
+    """``footfall bench tuning --scenarios``: the proxies' tune of the weights and CMA-ES on the same
+    runs' loss (issue 18, item 6), tiny here."""
+    from benchmarks.tuning_bench import run_events, table
+
+    result = run_events("spider", ("stairs",), max_evals=2, rounds=1,
+                        config_overrides=dict(seeds=(0,), frames=90, spawn_fractions=(0.3,), harvest_frames=10,
+                                              harvest_characters=1, max_situations=30, fit_steps=2))
+    proxy, cmaes = result["proxy"], result["cmaes"]
+    assert proxy["rounds_run"] == 1 and 2 <= proxy["exact_evals"] <= 4  # the defaults + a line search of 1-3
+    assert proxy["exact_loss"] <= proxy["start_exact_loss"]
+    assert 1 <= cmaes["exact_evals"] <= 2 and cmaes["dimension"] == 19
+    assert cmaes["reached"] == (cmaes["exact_loss"] <= result["target_loss"])
+    assert result["speedup_is_lower_bound"] == (not cmaes["reached"])
+    table(result)

@@ -130,3 +130,115 @@ def test_fit_arguments_are_checked(problem):
         _fit.fit(problem, n_steps=0)
     with pytest.raises(ValueError, match="tau"):
         _fit.make_problem(problem.situations, ("spider", "ant"), {}, 0.0)
+
+
+# --------------------------------------------------------------------------- the weights' blocks (issue 18, item 2)
+TERRAINS = ("stairs@terrain.start=-3.6", "crates", "hills", "mixed")
+WEIGHTS_TAU = 0.01  # the terrain and style tunes' temperature (tuning._tune.TuneConfig.for_terrain)
+# Central differences in log weights, step 1e-5: truncation ~1e-10, rounding ~1e-11 (see test_tuning_proxies).
+FD_ATOL_REL = 1e-6
+
+
+@pytest.fixture(scope="module")
+def terrain_problems():
+    """The spider's situations on stairs, crates, hills and mixed at the default parameters, as the
+    legacy fit sees them and with the weights' blocks (and a style whose ceilings the defaults cross)."""
+    import dataclasses
+
+    import tuning
+    from tuning import _fit
+
+    tuning.enable_x64()
+    harvest = harvest_situations(scenarios=TERRAINS, creatures=("spider",), seeds=(0,), frames=30, n_characters=2)
+    situations = tuning.situations_from_harvest(harvest)
+    targets = tuning.load_targets(creatures=("spider",))
+    style = {"max_touchdown_slope_rad": 0.02, "curvature_p95_max": 1e-6, "min_distance_ratio": 1.2}
+    styled = {"spider": dataclasses.replace(targets["spider"], style=style)}
+    legacy = _fit.make_problem(situations, harvest.creatures, targets, WEIGHTS_TAU)
+    weights = _fit.make_problem(situations, harvest.creatures, styled, WEIGHTS_TAU, weights_blocks=True,
+                                fit_timing=False)
+    return harvest, legacy, weights
+
+
+def _weights_jacobian(problem):
+    """d residuals (the targets' rows, without the prior) / d log weights at the harvest's parameters."""
+    import jax
+
+    from tuning import _fit
+
+    y0 = _fit.initial_params(problem)
+    n_prior = y0[0].size + y0[1].size
+
+    def f(log_weights):
+        return _fit.residuals((log_weights, y0[1]), problem)[:-n_prior]
+
+    return f, y0[0], np.asarray(jax.jacfwd(f)(y0[0]))
+
+
+def test_at_the_defaults_only_the_weights_blocks_give_the_weights_a_gradient(terrain_problems):
+    from planner._weights import N_TERMS
+
+    _, legacy, weights = terrain_problems
+    _, _, j_legacy = _weights_jacobian(legacy)
+    _, _, j_new = _weights_jacobian(weights)
+    # The legacy blocks: stride and duty read the timing alone; only the clearance hinge reaches a few
+    # crate-side situations (issue 18: exactly 0 on the spider's own hills runs).
+    before = np.linalg.norm(j_legacy[:, :N_TERMS])
+    assert before < 0.05
+    # With the weights' blocks every one of the ten scoring weights moves the residuals.
+    per_weight = np.linalg.norm(j_new[:, :N_TERMS], axis=0)
+    assert (per_weight > 1e-3).all(), per_weight
+    assert np.linalg.norm(j_new[:, :N_TERMS]) > 100.0 * before
+
+
+def test_the_weights_blocks_gradients_match_central_differences(terrain_problems):
+    import jax.numpy as jnp
+
+    import jax
+
+    _, _, weights = terrain_problems
+    f, x, _ = _weights_jacobian(weights)
+    # Off the defaults: clearance_ref_m = 0.07 m is the spider's cell, and many paths pass exactly one
+    # cell from a blocked one, where min(1, clearance / clearance_ref_m) has its kink.
+    x = x + jnp.log(jnp.asarray(np.random.default_rng(12).uniform(0.8, 1.25, x.size)))
+    jac = np.asarray(jax.jacfwd(f)(x))
+    fd = np.empty_like(jac)
+    step = 1e-5
+    for j in range(x.size):
+        e = jnp.zeros_like(x).at[j].set(step)
+        fd[:, j] = (np.asarray(f(x + e)) - np.asarray(f(x - e))) / (2.0 * step)
+    scale = max(float(np.abs(jac).max()), 1e-300)
+    assert np.abs(jac - fd).max() <= FD_ATOL_REL * scale, np.abs(jac - fd).max() / scale
+
+
+def test_the_offset_block_is_the_expected_distance_to_the_preferred_footprint(terrain_problems):
+    import tuning
+    from tuning import _fit
+
+    harvest, _, problem = terrain_problems
+    s = problem.situations
+    r = np.asarray(_fit.residuals(_fit.initial_params(problem), problem))
+    n = s.n_situations
+    start = 2 * n + 1 + 3  # stride, duty, slope, then jerk, curvature, clearance (one per creature)
+    block = r[start:start + n]
+    mask = np.asarray(problem.stride_mask)
+    m = tuning.expected_metrics(s.weights0, s.timing0, s, WEIGHTS_TAU, clearance_cap_m=problem.clearance_min_m)
+    expected = np.asarray(m["offset_m"]) / (0.15 * np.asarray(problem.stride_target_m)) / np.sqrt(mask.sum())
+    np.testing.assert_allclose(block[mask], expected[mask], rtol=1e-12, atol=0)
+    assert (block[~mask] == 0).all() and (block[mask] > 0).all()
+    # The offsets the hard choice makes: the soft expectation at this temperature is of the same size.
+    hard = np.asarray(tuning.hard_metrics(s.weights0, s.timing0, s)["offset_m"])[mask].mean()
+    soft = np.asarray(m["offset_m"])[mask].mean()
+    assert hard <= soft <= 2.0 * hard + 0.01, (hard, soft)
+
+
+def test_a_weights_only_fit_moves_the_weights_and_holds_the_timing(terrain_problems):
+    from tuning import _fit
+
+    _, _, problem = terrain_problems
+    loss0 = float(_fit.loss(_fit.initial_params(problem), problem))
+    weights, timing, history = _fit.fit(problem, n_steps=4)
+    assert history[-1] < loss0
+    np.testing.assert_array_equal(timing, np.asarray(problem.situations.timing0))
+    change = np.abs(np.log(weights) - np.asarray(problem.log_weights0))
+    assert change.max() > 0.05

@@ -10,10 +10,16 @@
 * :mod:`tuning._fit`: Levenberg-Marquardt (optimistix) on the target residuals,
   log-parametrised weights and timing, the steps as one ``lax.scan``.
 * :mod:`tuning._exact`: the exact loss -- the real crowd over a speed sweep, realised
-  stride length vs 2.3 h Fr^0.3, duty factor, curvature energy, clearance, collisions.
+  stride length vs the targets' law, duty factor, curvature energy, clearance, collisions.
 * :mod:`tuning._tune`: the outer loop (harvest -> fit -> exact loss, checkpoint after
   every round, resume), held-out evaluation and the preset (``footfall tune``). Shipped
   presets: ``tuning/data/presets/<creature>.json`` (:data:`PRESETS_DIR`).
+* :mod:`tuning._events`, :mod:`tuning._tune_events`: the terrain and style tunes of the scoring
+  weights (``footfall tune --scenarios ... --targets ...``, issue 18): runs that meet the terrain,
+  per-event metrics, the weights' fit blocks, held-out variants.
+* :mod:`tuning._validate`: the proxies' predicted metric changes against the exact runs' (Spearman).
+* :mod:`tuning._matrix`: the terrain and style presets' proof, a preset x terrain matrix on held-out
+  runs (``footfall bench presets``, ``tuning/data/matrix.json``).
 
 tuning/ computes in float64: its entry points call :func:`enable_x64`.
 """

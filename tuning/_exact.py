@@ -24,7 +24,7 @@ Measures (per run)
   horizontal speed over the same frames (the *realised* speed, not the desired
   one). The run's stride ratio is mean(stride) / mean(lambda_target(v_stride)),
   lambda_target = coefficient h Fr^exponent of ``tuning/data/targets.toml``
-  (2.3 h Fr^0.3, Alexander 1976). Footprints are cell centres of the planner's grid,
+  (the targets file's law, Alexander 1976 by default). Footprints are cell centres of the planner's grid,
   so single strides are quantised by the cell size; the mean over a run averages it out.
   ``stride_rel_error`` = mean over the runs of |ratio - 1| (the speed sweep).
 * **duty factor**: fraction of the measured frames a foot spends in stance, mean over
@@ -73,18 +73,21 @@ SWEEP_RATIO = 2.8
 SWEEP_POINTS = 4
 
 
-def sweep_froude(creature_name: str) -> tuple[float, ...]:
+def sweep_froude(creature_name: str, targets=None) -> tuple[float, ...]:
     """The creature's speed sweep as Froude numbers, geometric from Fr_lo to Fr_hi:
     Fr_lo = max(FROUDE_FLOOR, Fr at which lambda_target = STRIDE_MIN_CELLS cells),
-    Fr_hi = max(SWEEP_RATIO Fr_lo, FROUDE_CEILING_MIN)."""
+    Fr_hi = max(SWEEP_RATIO Fr_lo, FROUDE_CEILING_MIN). lambda_target is the stride law of
+    ``targets`` (:class:`tuning._targets.CreatureTargets`; None: the shipped targets file)."""
     from planner._crowd import planner_config_for
     from planner._timing import hip_height
     from scenarios import load_creature
+    from tuning._targets import load_tune_targets
 
     creature = load_creature(creature_name)
     h = hip_height(creature)
     cell = planner_config_for(creature).cell_size
-    low = max(FROUDE_FLOOR, (STRIDE_MIN_CELLS * cell / (2.3 * h)) ** (1.0 / 0.3))
+    coefficient, exponent = (targets or load_tune_targets(None, creature_name)).stride_law
+    low = max(FROUDE_FLOOR, (STRIDE_MIN_CELLS * cell / (coefficient * h)) ** (1.0 / exponent))
     high = max(SWEEP_RATIO * low, FROUDE_CEILING_MIN)
     return tuple(float(x) for x in np.geomspace(low, high, SWEEP_POINTS))
 COLLISION_PENALTY = 1.0

@@ -38,6 +38,26 @@ whatever the number of situations:
   exact median jerk rises above the default weights' (a "do not increase" guard);
   curvature: max(0, mean E[E] / maximum - 1);
   clearance: max(0, 1 - mean E[min(clearance, c)] / c), c = minimum h;
+* the weights' blocks (:data:`WEIGHT_BLOCKS`; on with ``weights_blocks=True``, the terrain and style
+  tunes of :mod:`tuning._tune`): soft expectations (temperature ``tau``) of what the scoring weights
+  decide, each a smooth function of every weight (the stride, duty and jerk blocks above depend on
+  the timing alone, and the curvature and clearance hinges are inactive at the defaults, so without
+  these blocks the Jacobian with respect to every weight is exactly 0 and Levenberg-Marquardt leaves
+  the weights where they are):
+
+  - offset, per new swing of a moving creature: E[|x - P|] / (tolerance lambda_target): the chosen
+    footprint's distance to the preferred one in stride tolerances. A stride is the spacing of two
+    touch-downs of one foot, lambda_i = lambda + o_i - o_(i-1) along the heading, so the per-stride
+    error is the offsets' difference: small offsets, small per-stride errors (always active);
+  - touch-down slope, per situation: relu(E[slope] / max_touchdown_slope - 1) (a style's ceiling;
+    off without one);
+  - detour, per situation: relu(log(E[path length / straight distance] min_distance_ratio)) (a style's
+    minimum distance ratio: a swing's detour makes the body walk less of what was asked; off without);
+  - touch-down clearance, per situation: relu(1 - E[min(obstacle distance, c)] / c), c = the style's
+    minimum clearance (body heights x h): footprints kept away from forbidden boxes (off without one);
+  - curvature p95, per situation: relu(log(E[E] / curvature_p95_max)): situations above a style's
+    ceiling (the per-situation hinge stands for the 95th percentile of the runs; off without one).
+
 * prior: (y - y_0) / PRIOR_LOG_SCALE, so that parameters no target constrains stay at
   the harvest's values (the problem is otherwise under-determined).
 
@@ -62,6 +82,8 @@ from tuning._proxies import Situations, duty_factor, expected_metrics, stride_fr
 
 FITTED_TIMING = ("stride_coefficient", "stride_exponent", "duty_at_rest", "duty_slope")
 _FITTED_INDEX = np.array([TIMING_FIELDS.index(n) for n in FITTED_TIMING])
+WEIGHT_BLOCKS = ("offset", "touchdown_slope", "detour", "touchdown_clearance", "curvature_p95")
+"""The weights' residual blocks, in the order of :func:`residuals` (module docstring)."""
 PRIOR_LOG_SCALE = 1.0
 """A factor e away from the harvest's value costs as much as one target missed by its tolerance."""
 
@@ -87,15 +109,27 @@ class FitProblem(eqx.Module):
     log_weights0: jax.Array
     log_timing0: jax.Array  # (4,)
     jerk_weight: jax.Array  # () weight of the jerk block (0 by default: module docstring)
+    offset_weight: jax.Array  # () weight of the offset block (0: off; module docstring)
+    slope_max: jax.Array  # (F,) the style's touch-down slope ceiling (rad; inf: none)
+    detour_max: jax.Array  # (F,) 1 / the style's minimum distance ratio (inf: none)
+    curvature_p95_max: jax.Array  # (F,) the style's curvature p95 ceiling (inf: none)
+    touchdown_clearance_m: jax.Array  # (F,) the style's minimum clearance to forbidden boxes (m; 0: none)
+    prior_log_scale: jax.Array = PRIOR_LOG_SCALE  # () the prior's scale (module docstring)
+    fit_timing: bool = eqx.field(static=True, default=True)
 
 
 def make_problem(situations: Situations, creature_names, targets, tau: float, jerk_weight: float = 0.0,
-                 stride_correction=None, duty_correction=None) -> FitProblem:
+                 stride_correction=None, duty_correction=None, weights_blocks: bool = False,
+                 fit_timing: bool = True, offset_weight: float = 1.0,
+                 prior_log_scale: float = PRIOR_LOG_SCALE) -> FitProblem:
     """``creature_names``: the harvest's ``creatures`` (``situations.creature`` indexes it);
     ``targets``: :func:`tuning.load_targets` output holding those creatures; ``jerk_weight``:
     weight of the jerk block (0: off, the default; module docstring); ``stride_correction``:
     c per situation (F,), realised / commanded stride (None: 1, the timing model taken at its word);
-    ``duty_correction``: d per situation (F,), realised - commanded duty factor (None: 0)."""
+    ``duty_correction``: d per situation (F,), realised - commanded duty factor (None: 0);
+    ``weights_blocks``: the weights' blocks (offset, weighted ``offset_weight``, and the style's bounds
+    where the targets state a style; module docstring); ``fit_timing`` False: the timing is held at the harvest's (its
+    Jacobian columns are zero and its prior keeps it there): a tune of the weights alone."""
     if not tau > 0.0:
         raise ValueError(f"tau: expected a temperature > 0, got {tau!r}")
     if isinstance(jerk_weight, bool) or not isinstance(jerk_weight, (int, float)) or not jerk_weight >= 0.0:
@@ -137,12 +171,31 @@ def make_problem(situations: Situations, creature_names, targets, tau: float, je
         clearance_min_m=col(lambda t: t.clearance_min_m),
         creature_one_hot=jnp.asarray(index[:, None] == np.arange(len(creature_names))[None, :], dtype=jnp.float64),
         log_weights0=jnp.log(jnp.asarray(weights0)), log_timing0=jnp.log(jnp.asarray(timing0[_FITTED_INDEX])),
-        jerk_weight=jnp.asarray(float(jerk_weight), dtype=jnp.float64))
+        jerk_weight=jnp.asarray(float(jerk_weight), dtype=jnp.float64),
+        offset_weight=jnp.asarray(float(offset_weight) if weights_blocks else 0.0, dtype=jnp.float64),
+        slope_max=col(lambda t: _style(t, "max_touchdown_slope_rad", weights_blocks)),
+        detour_max=col(lambda t: 1.0 / _style(t, "min_distance_ratio", weights_blocks, 0.0) if _style(
+            t, "min_distance_ratio", weights_blocks, 0.0) > 0.0 else np.inf),
+        curvature_p95_max=col(lambda t: _style(t, "curvature_p95_max", weights_blocks)),
+        touchdown_clearance_m=col(lambda t: _style(t, "min_clearance_body_heights", weights_blocks, 0.0)
+                                  * t.leg_length_m),
+        prior_log_scale=jnp.asarray(float(prior_log_scale), dtype=jnp.float64), fit_timing=bool(fit_timing))
+
+
+def _style(target, key: str, on: bool, none: float = np.inf) -> float:
+    """A style's number of a creature's targets (``CreatureTargets.style``), or ``none``."""
+    style = getattr(target, "style", None) or {}
+    return float(style[key]) if on and key in style else none
 
 
 def timing_vector(log_timing, timing0):
     """Full GaitTiming vector: the fitted fields from ``log_timing``, the others from ``timing0``."""
     return jnp.asarray(timing0).at[_FITTED_INDEX].set(jnp.exp(log_timing))
+
+
+def _log(x):
+    """log x, floored at 1e-300 (a straight path's curvature is 0 or 1e-27) with finite gradients."""
+    return jnp.log(jnp.maximum(x, 1e-300))
 
 
 def _block(values, mask):
@@ -153,10 +206,17 @@ def _block(values, mask):
 def residuals(params, problem: FitProblem):
     """The residual vector (module docstring) at ``params = (log_weights, log_timing)``."""
     log_weights, log_timing = params
+    if not problem.fit_timing:
+        log_timing = jax.lax.stop_gradient(log_timing)
     s = problem.situations
     w = jnp.exp(log_weights)
     timing = timing_vector(log_timing, s.timing0)
-    m = expected_metrics(w, timing, s, problem.tau, clearance_cap_m=problem.clearance_min_m)
+    # The touch-down clearance is capped at the style's minimum where there is one (the path clearance
+    # at the clearance target, as before).
+    td_on = problem.touchdown_clearance_m > 0.0
+    m = expected_metrics(w, timing, s, problem.tau, clearance_cap_m=problem.clearance_min_m,
+                         touchdown_cap_m=jnp.where(td_on, problem.touchdown_clearance_m, 1.0))
+    td = m["touchdown_clearance_m"]
     moving = s.speed > 0.0
     frequency = stride_frequency(timing, s.speed, s.leg_height)
     commanded = jnp.where(moving, s.speed / jnp.where(moving, frequency, 1.0), 0.0)
@@ -179,6 +239,17 @@ def residuals(params, problem: FitProblem):
     jerk = jax.nn.relu(jnp.log(per_creature(m["jerk"]) / jnp.where(present, jerk_max, 1.0)))
     curvature = jax.nn.relu(per_creature(m["curvature_energy"]) / jnp.where(present, curvature_max, 1.0) - 1.0)
     clearance = jax.nn.relu(1.0 - per_creature(m["clearance_m"]) / jnp.where(present, clearance_min, 1.0))
+    scale = jnp.where(problem.stride_mask, problem.stride_tolerance * problem.stride_target_m, 1.0)  # 0 when standing
+    offset = jnp.sqrt(problem.offset_weight) * m["offset_m"] / scale
+    slope_on = jnp.isfinite(problem.slope_max)
+    slope_hinge = jax.nn.relu(m["touchdown_slope_rad"] / jnp.where(slope_on, problem.slope_max, 1.0) - 1.0)
+    detour_on = jnp.isfinite(problem.detour_max)
+    # Log ratios (as the exact run losses, tuning._events): a few detours around a crate are 10x the
+    # straight distance, and a linear hinge squared let them dominate the fit.
+    detour = jax.nn.relu(_log(m["detour_ratio"]) - jnp.log(jnp.where(detour_on, problem.detour_max, 1.0)))
+    td_hinge = jax.nn.relu(1.0 - td / jnp.where(td_on, problem.touchdown_clearance_m, 1.0))
+    curv_on = jnp.isfinite(problem.curvature_p95_max)
+    curv = jax.nn.relu(_log(m["curvature_energy"]) - jnp.log(jnp.where(curv_on, problem.curvature_p95_max, 1.0)))
     return jnp.concatenate([
         _block(jnp.where(problem.stride_mask, stride, 0.0), problem.stride_mask),
         _block(duty_out, problem.duty_mask),
@@ -186,8 +257,13 @@ def residuals(params, problem: FitProblem):
         jnp.sqrt(problem.jerk_weight) * jnp.where(present, jerk, 0.0),
         jnp.where(present, curvature, 0.0),
         jnp.where(present, clearance, 0.0),
-        (log_weights - problem.log_weights0) / PRIOR_LOG_SCALE,
-        (log_timing - problem.log_timing0) / PRIOR_LOG_SCALE,
+        _block(jnp.where(problem.stride_mask, offset, 0.0), problem.stride_mask & (problem.offset_weight > 0.0)),
+        _block(slope_hinge, slope_on),
+        _block(detour, detour_on),
+        _block(td_hinge, td_on),
+        _block(curv, curv_on),
+        (log_weights - problem.log_weights0) / problem.prior_log_scale,
+        (log_timing - problem.log_timing0) / problem.prior_log_scale,
     ])
 
 

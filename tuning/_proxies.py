@@ -14,6 +14,16 @@ climb, jerk, ...) as smooth functions of the scoring weights ``w``
 argmax (uniform over exact ties), so the expectations tend to the metrics of the
 couple the exhaustive search picks.
 
+Temperature
+-----------
+Couple scores are weighted means of goodnesses in [0, 1]. At tau a couple whose score is tau lower
+than another weighs e^-1 as much. The legacy stride tune uses tau = 0.05; the terrain and style tunes
+(the weights' blocks of :mod:`tuning._fit`) use tau = 0.01: a spider's candidate one cell (7 cm)
+farther from the preferred footprint loses 3/13 x 0.07 / 0.3 = 0.054 of score at the default weights
+and weighs e^-5.4 (0.5 %) as much, so the expected offset from the preferred footprint stays near the
+argmax's (1.4 cm against 0.9 cm on stairs, crates, hills and mixed) while near-ties still share the
+probability and give every weight a gradient.
+
 How the timing parameters reach the choice
 ------------------------------------------
 theta shapes the *preferred footprint* P the controller asks for
@@ -56,8 +66,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from planner._kernels_foot import FEAT_DISTANCE, N_FEATURES, N_RAW, RAW_CLEARANCE, RAW_CLIMB, RAW_CURVATURE, RAW_JERK
-from planner._kernels_foot import RAW_LENGTH
+from planner._kernels_foot import FEAT_DISTANCE, FEAT_PROXIMITY, FEAT_ROUGHNESS, FEAT_SLOPE, N_FEATURES, N_RAW, RAW_CLEARANCE, RAW_CLIMB
+from planner._kernels_foot import RAW_CURVATURE, RAW_JERK, RAW_LENGTH
 from planner._timing import (
     GRAVITY,
     SWING_MAX,
@@ -77,13 +87,23 @@ LEAST_FREQUENCY_HZ = 1e-3
 """The crowd divides by max(f, 1e-3) (planner._crowd.stage_plan)."""
 KIND_REPLAN = 3
 
-PROXY_METRICS = ("step_length_m", "forward_offset_m", "length_m", "curvature_energy", "clearance_m", "climb_m", "jerk",
-                 "couple_score")
+PROXY_METRICS = ("step_length_m", "forward_offset_m", "offset_m", "touchdown_slope_rad", "touchdown_roughness_m",
+                 "detour_ratio", "touchdown_clearance_m", "length_m", "curvature_energy", "clearance_m", "climb_m", "jerk", "couple_score")
 """Keys of :func:`expected_metrics`, each (F,) per situation:
 
 * ``step_length_m``: horizontal distance source -> target;
 * ``forward_offset_m``: (target - P) along the heading (how far the weights pull the
   foot ahead of, > 0, or behind the preferred footprint);
+* ``offset_m``: |target - P|, the distance feature (how far the chosen footprint lands from the
+  preferred one: a stride is the spacing of two touch-downs, so the offsets are what the weights
+  add to the per-stride error, :mod:`tuning._fit`);
+* ``touchdown_slope_rad``, ``touchdown_roughness_m``: the slope and the roughness (largest height
+  step to a neighbour cell) under the chosen footprint (``planner.FEATURES``);
+* ``detour_ratio``: the swing path's ground length / the straight distance source -> footprint
+  (``d_ref``): 1 for a direct swing, more for a detour around or over an obstacle;
+* ``touchdown_clearance_m``: the footprint's distance to forbidden cells (``obstacle_distance_m``,
+  the creature-dilated forbidden region of the local map), capped at ``clearance_cap_m`` as the
+  path clearance is (+inf when no forbidden cell is in the map);
 * ``length_m``, ``curvature_energy``, ``clearance_m``, ``climb_m``, ``jerk``: the raw
   trajectory metrics (``planner.RAW_METRICS``); the clearance is capped at
   ``clearance_cap_m`` (a number or (F,); +inf when nothing is blocked around a path);
@@ -229,12 +249,13 @@ def soft_selection(scores, mask, tau):
     return (e / jnp.sum(e, axis=1, keepdims=True)).reshape(scores.shape)
 
 
-def expected_metrics(weights, timing, situations: Situations, tau, clearance_cap_m=jnp.inf):
+def expected_metrics(weights, timing, situations: Situations, tau, clearance_cap_m=jnp.inf, touchdown_cap_m=None):
     """Expectations under the soft selection at temperature ``tau`` (> 0): a dict of (F,)
-    arrays keyed by :data:`PROXY_METRICS`."""
+    arrays keyed by :data:`PROXY_METRICS`. ``touchdown_cap_m``: the cap of ``touchdown_clearance_m``
+    (a number or (F,); None: ``clearance_cap_m``)."""
     scores = couple_scores(weights, timing, situations)
     p = soft_selection(scores, situations.couple_mask, tau)
-    return _metrics_under(p, scores, timing, situations, clearance_cap_m)
+    return _metrics_under(p, scores, timing, situations, clearance_cap_m, touchdown_cap_m)
 
 
 def hard_metrics(weights, timing, situations: Situations, clearance_cap_m=jnp.inf):
@@ -248,7 +269,7 @@ def hard_metrics(weights, timing, situations: Situations, clearance_cap_m=jnp.in
     return _metrics_under(one_hot, scores, timing, s, clearance_cap_m)
 
 
-def _metrics_under(p, scores, timing, s, clearance_cap_m):
+def _metrics_under(p, scores, timing, s, clearance_cap_m, touchdown_cap_m=None):
     """The PROXY_METRICS under the selection p (F, K, S)."""
     pref = preferred_footprint(timing, s)
 
@@ -259,16 +280,33 @@ def _metrics_under(p, scores, timing, s, clearance_cap_m):
     step = _norm(x[..., 0] - s.source[:, None, 0], x[..., 1] - s.source[:, None, 2])
     ahead = ((x[..., 0] - pref[:, None, 0]) * s.forward[:, None, 0]
              + (x[..., 1] - pref[:, None, 1]) * s.forward[:, None, 1])
-    _, raw = moved_paths(s, x)
+    offset = _norm(x[..., 0] - pref[:, None, 0], x[..., 1] - pref[:, None, 1])
+    d_ref, raw = moved_paths(s, x)
     clearance = raw[..., RAW_CLEARANCE]
     finite = jnp.isfinite(clearance)
     cap = jnp.asarray(clearance_cap_m, dtype=clearance.dtype)
     cap = cap.reshape(cap.shape + (1,) * (clearance.ndim - cap.ndim))  # a number or (F,) per situation
     capped = jnp.where(finite, jnp.minimum(jnp.where(finite, clearance, 0.0), cap), cap)
+    prox = s.cand_features[..., FEAT_PROXIMITY]
+    prox_finite = jnp.isfinite(prox)
+    cap_k = cap[..., 0]  # (1, 1) or (F, 1): per candidate
+    if touchdown_cap_m is not None:
+        cap_k = jnp.asarray(touchdown_cap_m, dtype=clearance.dtype)
+        cap_k = cap_k.reshape(cap_k.shape + (1,) * (2 - cap_k.ndim))
+    prox_capped = jnp.where(prox_finite, jnp.minimum(jnp.where(prox_finite, prox, 0.0), cap_k), cap_k)
     shape = raw.shape[:-1]
+
+    def per_candidate(values):  # (F, K) -> (F, K, S)
+        return jnp.broadcast_to(values[..., None], shape)
+
     return {
-        "step_length_m": expect(jnp.broadcast_to(step[..., None], shape)),
-        "forward_offset_m": expect(jnp.broadcast_to(ahead[..., None], shape)),
+        "step_length_m": expect(per_candidate(step)),
+        "forward_offset_m": expect(per_candidate(ahead)),
+        "offset_m": expect(per_candidate(offset)),
+        "touchdown_slope_rad": expect(per_candidate(s.cand_features[..., FEAT_SLOPE])),
+        "touchdown_roughness_m": expect(per_candidate(s.cand_features[..., FEAT_ROUGHNESS])),
+        "detour_ratio": expect(raw[..., RAW_LENGTH] / d_ref[..., None]),
+        "touchdown_clearance_m": expect(per_candidate(jnp.broadcast_to(prox_capped, step.shape))),
         "length_m": expect(raw[..., RAW_LENGTH]),
         "curvature_energy": expect(raw[..., RAW_CURVATURE]),
         "clearance_m": expect(capped),

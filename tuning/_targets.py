@@ -16,10 +16,41 @@ Quantities (fields; all numbers):
 * ``swing_jerk``: ``minimum``, ``maximum`` -- normalised jerk J* of a swing;
 * ``curvature_energy``: ``maximum`` -- curvature energy of a swing path;
 * ``clearance``: ``minimum`` -- horizontal path margin / h.
+
+A **user's targets file** (``footfall tune --targets FILE.toml``, :func:`load_tune_targets`) is
+laid over these for the creature tuned. Every table is optional but ``schema_version``::
+
+    schema_version = 1
+
+    [sources]                    # citations that the entries below may name (optional)
+    my_trackways = "Smith 2020: stride of Lycosa at a walk"
+
+    [stride_length]              # the stride law lambda / h = coefficient Fr^exponent (species data)
+    coefficient = 2.0
+    exponent = 0.3
+    relative_tolerance = 0.15
+    source = "my_trackways"      # optional in a user file: the file itself is the source
+
+    [duty_factor]                # the duty-factor band at walking speeds
+    low = 0.6
+    high = 0.8
+    froude_max = 1.0
+
+    [style]                      # how the creature should walk (each key optional)
+    min_clearance_body_heights = 0.5   # swing paths keep this far (x body height h) from forbidden boxes
+    curvature_p95_max = 0.02           # 95th percentile of the swing paths' curvature energy
+    min_distance_ratio = 0.95          # distance walked / distance asked
+    max_touchdown_slope_rad = 0.3      # mean slope under the touch-downs
+
+Any quantity of the shipped file may be given the same way (it replaces the whole entry); a file
+with a ``[defaults]`` table is read as a whole targets file instead (:func:`load_targets`). The
+body height is the creature's hip height h standing (the leg length of the Froude number): the
+style's clearance becomes the ``clearance`` target's minimum. Examples: ``tuning/data/styles/``.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import tomllib
 from dataclasses import dataclass
@@ -42,6 +73,13 @@ _FIELDS: dict[str, dict[str, tuple[float | None, float | None, bool]]] = {
     "clearance": {"minimum": (0.0, None, True)},
 }
 QUANTITIES: tuple[str, ...] = tuple(_FIELDS)
+STYLE_FIELDS: dict[str, tuple[float | None, float | None, bool]] = {
+    "min_clearance_body_heights": (0.0, None, True),
+    "curvature_p95_max": (0.0, None, True),
+    "min_distance_ratio": (0.0, 1.5, True),
+    "max_touchdown_slope_rad": (0.0, 1.5, True),
+}
+"""A style's keys (``[style]`` of a user's targets file) with their bounds."""
 
 
 @dataclass(frozen=True)
@@ -61,6 +99,8 @@ class CreatureTargets:
     creature: str
     leg_length_m: float
     targets: dict[str, Target]
+    style: dict | None = None  # STYLE_FIELDS -> number (None: no style stated)
+    file: str | None = None  # the targets file these came from (None: the shipped one)
 
     def __getitem__(self, quantity: str) -> Target:
         return self.targets[quantity]
@@ -74,6 +114,33 @@ class CreatureTargets:
     @property
     def clearance_min_m(self) -> float:
         return self.targets["clearance"].values["minimum"] * self.leg_length_m
+
+    @property
+    def stride_law(self) -> tuple[float, float]:
+        """(coefficient, exponent) of the stride law lambda / h = coefficient Fr^exponent."""
+        t = self.targets["stride_length"].values
+        return t["coefficient"], t["exponent"]
+
+    def stride_law_text(self, html: bool = False) -> str:
+        """The stride law as text, e.g. ``2.3 h Fr^0.3`` (the numbers of the targets file)."""
+        c, e = self.stride_law
+        return f"{c:g} h Fr<sup>{e:g}</sup>" if html else f"{c:g} h Fr^{e:g}"
+
+    def timing(self, base=None):
+        """``base`` (default ``GaitTiming()``) with the stride law of these targets: the runtime
+        then commands the target law, and its per-stride error is measured against it."""
+        import dataclasses
+
+        from planner._timing import GaitTiming
+
+        c, e = self.stride_law
+        return dataclasses.replace(base or GaitTiming(), stride_coefficient=c, stride_exponent=e)
+
+    def to_json(self) -> dict:
+        """The numbers (per quantity) and the style: what a preset's provenance records."""
+        return {"file": self.file or "tuning/data/targets.toml", "leg_length_m": self.leg_length_m,
+                **{q: dict(t.values, source=t.source) for q, t in self.targets.items()},
+                "style": dict(self.style or {})}
 
     @property
     def citations(self) -> dict[str, str]:
@@ -176,3 +243,70 @@ def load_targets(path: str | Path = TARGETS_FILE, creatures=None) -> dict[str, C
         targets.update(per_creature.get(creature.name, {}))
         out[creature.name] = CreatureTargets(creature.name, hip_height(creature), targets)
     return out
+
+
+def _read(path) -> dict:
+    file = str(path)
+    try:
+        return tomllib.loads(Path(path).read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise InputError(file, "targets", "file not found") from None
+    except IsADirectoryError:
+        raise InputError(file, "targets", "is a directory, not a targets .toml") from None
+    except OSError as error:
+        raise InputError(file, "targets", f"cannot read file: {error.strerror or error}") from None
+    except UnicodeDecodeError:
+        raise InputError(file, "targets", "not UTF-8 text") from None
+    except tomllib.TOMLDecodeError as error:
+        raise InputError(file, "targets", f"invalid TOML: {str(error).splitlines()[0]}") from None
+
+
+def load_tune_targets(path: str | Path | None, creature: str) -> CreatureTargets:
+    """The targets of one creature for ``footfall tune``: the shipped ones (``path`` None), a whole
+    targets file (one with ``[defaults]``), or a user's file laid over the shipped ones (module
+    docstring). A malformed file is refused with an :class:`InputError` naming it and the field."""
+    from scenarios import load_creature
+
+    name = load_creature(creature).name
+    if path is None:
+        return load_targets(creatures=(creature,))[name]
+    file = str(path)
+    data = _read(path)
+    if "defaults" in data:
+        return dataclasses.replace(load_targets(path, creatures=(creature,))[name], file=file)
+    allowed = ("schema_version", "sources", "style", *QUANTITIES)
+    for key in data:
+        if key not in allowed:
+            raise InputError(file, key, f"unknown field; expected {', '.join(allowed)}")
+    if data.get("schema_version") != TARGETS_SCHEMA_VERSION:
+        raise InputError(file, "schema_version", f"expected {TARGETS_SCHEMA_VERSION}, got {data.get('schema_version')!r}")
+    base = load_targets(creatures=(creature,))[name]
+    shipped_sources = tomllib.loads(TARGETS_FILE.read_text(encoding="utf-8"))["sources"]
+    sources = data.get("sources", {})
+    if not isinstance(sources, dict):
+        raise InputError(file, "sources", "expected a table of citations")
+    for key, text in sources.items():
+        if not isinstance(text, str) or not text.strip():
+            raise InputError(file, f"sources.{key}", "expected a citation (non-empty text)")
+    sources = {**shipped_sources, **sources, "this_file": f"user targets file {file}"}
+    targets = dict(base.targets)
+    for quantity in QUANTITIES:
+        if quantity in data:
+            entry = data[quantity]
+            if isinstance(entry, dict) and "source" not in entry:
+                entry = dict(entry, source="this_file")
+            targets[quantity] = _target(file, quantity, quantity, entry, sources)
+    style = None
+    if "style" in data:
+        table = data["style"]
+        if not isinstance(table, dict):
+            raise InputError(file, "style", "expected a table")
+        style = {}
+        for key, value in table.items():
+            if key not in STYLE_FIELDS:
+                raise InputError(file, f"style.{key}", f"unknown field; a style has {', '.join(STYLE_FIELDS)}")
+            style[key] = _number(file, f"style.{key}", value, STYLE_FIELDS[key])
+        if "min_clearance_body_heights" in style:
+            targets["clearance"] = Target("clearance", {"minimum": style["min_clearance_body_heights"]}, "this_file",
+                                          sources["this_file"])
+    return CreatureTargets(base.creature, base.leg_length_m, targets, style, file)

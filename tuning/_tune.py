@@ -331,6 +331,10 @@ def _pad_problem(problem, n: int, k: int, s: int):
         jerk_max=jnp.asarray(pad(problem.jerk_max, 1.0, rows)),
         curvature_max=jnp.asarray(pad(problem.curvature_max, 1.0, rows)),
         clearance_min_m=jnp.asarray(pad(problem.clearance_min_m, 1.0, rows)),
+        slope_max=jnp.asarray(pad(problem.slope_max, np.inf, rows)),
+        detour_max=jnp.asarray(pad(problem.detour_max, np.inf, rows)),
+        curvature_p95_max=jnp.asarray(pad(problem.curvature_p95_max, np.inf, rows)),
+        touchdown_clearance_m=jnp.asarray(pad(problem.touchdown_clearance_m, 0.0, rows)),
         creature_one_hot=jnp.asarray(pad(problem.creature_one_hot, 0.0, rows)))
 
 
@@ -527,6 +531,15 @@ def _accept(candidate: dict, best: dict, default: dict, gain_noise_se: float = G
     return True, "improved"
 
 
+def _gain_in_se(default: dict, tuned: dict) -> float | None:
+    """The held-out paired gain of ``tuned`` over ``default`` in standard errors (None: no spread)."""
+    try:
+        gain, se = paired_gain(default, tuned)
+    except ValueError:
+        return None
+    return gain / se if se > 0.0 else None
+
+
 def _strip(metrics: dict) -> dict:
     return {k: v for k, v in metrics.items() if k != "runs"} | {"runs": metrics["runs"]}
 
@@ -666,6 +679,14 @@ def _tune(config: TuneConfig, out, resume, progress, stop_after, write, evaluate
         "spearman_proxy_exact": rho, "spearman_couples": n_couples,
         "rounds_run": state["round"], "best_round": best["round"],
         "heldout_refused": refused,
+        # The keys the terrain and style tunes share (tuning._tune_events; issue 18, item 7).
+        "scenarios": list(setup.scenarios),
+        "targets": targets[config.creature].to_json(),
+        "heldout_loss_default": held_default["exact_loss"], "heldout_loss_tuned": held_tuned["exact_loss"],
+        "heldout_gain_se": _gain_in_se(held_default, held_tuned),
+        "weights_max_rel_change": float(np.max(np.abs(np.asarray(best["params"]["weights"])
+                                                      / np.asarray(_default_params()["weights"]) - 1.0))),
+        "spearman_metric_change": None,
     }
     if config.start_timing:
         summary.update({
@@ -692,7 +713,7 @@ def _tune(config: TuneConfig, out, resume, progress, stop_after, write, evaluate
                   "heldout": list(holdout.seeds), "spearman": config.seed + 1000},
         "speed_sweep_froude": list(setup.froude),
         "stride_definition": "distance a foot travels between consecutive touch-downs (same foot, one cycle) vs "
-                             "lambda_target = 2.3 h Fr^0.3 at the pelvis's realised speed; stride_rel_error = mean "
+                             f"lambda_target = {targets[config.creature].stride_law_text()} at the pelvis's realised speed; stride_rel_error = mean "
                              "over the runs of |mean stride / mean target - 1|",
         "losses": {"default": brief(default_exact), "tuned": brief(best["exact"]),
                    "heldout_default": brief(held_default), "heldout_tuned": brief(held_tuned),

@@ -1,0 +1,213 @@
+"""The proof of the terrain and style presets: a preset x terrain matrix on held-out runs (issue 18, item 5).
+
+Every preset of :data:`PRESETS` is run against the runtime's defaults on every terrain of
+:data:`TERRAINS` -- held-out variants none of the tunes saw (other risers and treads, other crate
+layouts and hills), spawned along the route (:mod:`tuning._events`), seeds :data:`SEED_BASE` ... --
+``runs`` paired runs per cell (the same scenario, spawn and seed under both parameter sets). Per
+cell, for the main metric (the per-stride error, lower is better) and for a style preset's metrics:
+the paired mean difference, its standard error, and the gain in standard errors (> 0: the preset
+is better, or moves toward its style's bound).
+
+A preset **passes** (``footfall bench presets`` says so, and only a passing preset ships in
+``tuning/data/presets/``):
+
+* a terrain preset: gain >= :data:`WIN_SE` on its own terrain, >= -:data:`LOSS_SE` on every other;
+* a style preset: on each terrain it was tuned for, its first style metric moves >= :data:`WIN_SE`
+  toward its bound;
+* both: no rise of collisions and body overlaps over the defaults' in any cell
+  (:func:`tuning._events.collisions_rise`).
+
+Regenerate a preset with its ``command`` (:data:`PRESETS`), then the matrix with
+``footfall bench presets --out tuning/data/matrix.json`` (:func:`run_matrix`). The runs are
+deterministic: the same presets give the same matrix, bit for bit.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from pathlib import Path
+
+import numpy as np
+
+from tuning._events import LOWER_BOUND_STYLES, STYLE_METRIC, EventSetup, collisions_rise, event_metrics
+
+MATRIX_FILE = Path(__file__).resolve().parent / "data" / "matrix.json"
+TERRAINS = {
+    "stairs": "stairs@terrain.rise=0.1,terrain.run=0.3",
+    "crates": "crates@seed=13",
+    "hills": "hills@seed=5",
+    "mixed": "mixed@seed=19",
+}
+"""Held-out variants (none is a tune's training or held-out scenario)."""
+CHARACTERS = {"mixed": 3}
+"""Characters per run on a terrain (default 1): mixed with its own crowd of three spiders."""
+SEED_BASE = 500
+MAIN_METRIC = "stride_error"
+WIN_SE = 2.0
+LOSS_SE = 1.0
+RUNS = 30
+SPAWNS = (0.15, 0.3, 0.45)
+
+PRESETS = {
+    "spider-stairs": {"creature": "spider", "terrain": "stairs",
+                      "command": "footfall tune --creature spider --scenarios stairs --spearman-candidates 20 "
+                                 "--out tuning/data/presets/spider-stairs.json"},
+    "quadruped-stairs": {"creature": "quadruped", "terrain": "stairs",
+                         "command": "footfall tune --creature quadruped --scenarios stairs "
+                                    "--out tuning/data/presets/quadruped-stairs.json"},
+    "ant-crates": {"creature": "ant", "terrain": "crates",
+                   "command": "footfall tune --creature ant --scenarios crates --out tuning/data/presets/ant-crates.json"},
+    "spider-mixed": {"creature": "spider", "terrain": "mixed",
+                     "command": "footfall tune --creature spider --scenarios mixed --characters 3 "
+                                "--out tuning/data/presets/spider-mixed.json"},
+    "spider-cautious": {"creature": "spider", "style": "tuning/data/styles/cautious.toml", "terrains": ("crates", "mixed"),
+                        "command": "footfall tune --creature spider --scenarios crates,mixed --targets "
+                                   "tuning/data/styles/cautious.toml --out tuning/data/presets/spider-cautious.json"},
+    "spider-direct": {"creature": "spider", "style": "tuning/data/styles/direct.toml", "terrains": ("crates", "mixed"),
+                      "command": "footfall tune --creature spider --scenarios crates,mixed --targets "
+                                 "tuning/data/styles/direct.toml --out tuning/data/presets/spider-direct.json"},
+}
+"""The terrain and style presets: creature, what they are for, and the one command that regenerates each."""
+
+
+def cell_setup(creature: str, terrain: str, runs: int = RUNS) -> EventSetup:
+    """The held-out runs of one cell: ``runs`` = spawns x seeds."""
+    seeds = int(math.ceil(runs / len(SPAWNS)))
+    return EventSetup(creature, (TERRAINS[terrain],), tuple(range(SEED_BASE, SEED_BASE + seeds)),
+                      n_characters=CHARACTERS.get(terrain, 1), spawn_fractions=SPAWNS)
+
+
+def _paired(a: dict, b: dict, key: str, sign: float) -> dict:
+    """sign x (a - b) per run, paired: mean, SE, n, mean / SE; a = defaults, b = preset."""
+    x = np.array([r[key] for r in a["runs"]], dtype=np.float64)
+    y = np.array([r[key] for r in b["runs"]], dtype=np.float64)
+    keep = np.isfinite(x) & np.isfinite(y)
+    d = sign * (x - y)[keep]
+    n = int(d.size)
+    mean = float(d.mean()) if n else math.nan
+    se = float(d.std(ddof=1) / math.sqrt(n)) if n > 1 else math.nan
+    return {"default": float(x[keep].mean()) if n else None, "preset": float(y[keep].mean()) if n else None,
+            "gain": mean, "se": se, "n": n, "gain_se": mean / se if se > 0 else (0.0 if mean == 0 else math.copysign(math.inf, mean))}
+
+
+def style_of(name: str) -> dict:
+    """The style (key -> bound) of a style preset, from its targets file; {} for a terrain preset."""
+    from tuning._targets import load_tune_targets
+
+    spec = PRESETS[name]
+    if "style" not in spec:
+        return {}
+    return dict(load_tune_targets(_repo_path(spec["style"]), spec["creature"]).style or {})
+
+
+def _repo_path(relative: str) -> Path:
+    return Path(__file__).resolve().parent.parent / relative
+
+
+def evaluate_cell(default: dict, preset: dict, style: dict) -> dict:
+    """One cell from the default's and the preset's event metrics of the same runs."""
+    rises, mean, se = collisions_rise(default, preset)
+    cell = {"main": _paired(default, preset, MAIN_METRIC, 1.0),
+            "collisions_default": default["collisions"], "collisions_preset": preset["collisions"],
+            "collisions_rise": rises, "collisions_change_per_run": mean, "collisions_change_se": se, "style": {}}
+    for key in style:
+        metric = STYLE_METRIC[key]
+        # Toward the bound: up for a lower bound (clearance, distance ratio), down for a ceiling.
+        cell["style"][key] = {"metric": metric, **_paired(default, preset, metric,
+                                                          -1.0 if key in LOWER_BOUND_STYLES else 1.0)}
+    return cell
+
+
+def verdict(name: str, cells: dict, style: dict) -> tuple[bool, list[str]]:
+    """(passes, reasons it does not) of a preset from its cells (module docstring)."""
+    spec = PRESETS[name]
+    why = []
+    for terrain, cell in cells.items():
+        if cell["collisions_rise"]:
+            why.append(f"{terrain}: collisions rise {cell['collisions_default']} -> {cell['collisions_preset']}")
+    if "terrain" in spec:
+        own = spec["terrain"]
+        for terrain, cell in cells.items():
+            g = cell["main"]["gain_se"]
+            if terrain == own and not g >= WIN_SE:
+                why.append(f"{terrain} (own): per-stride error gain {g:.2f} SE < {WIN_SE:g}")
+            if terrain != own and not g >= -LOSS_SE:
+                why.append(f"{terrain}: per-stride error loses {-g:.2f} SE > {LOSS_SE:g}")
+    else:
+        first = next(iter(style))
+        for terrain in spec["terrains"]:
+            g = cells[terrain]["style"][first]["gain_se"]
+            if not g >= WIN_SE:
+                why.append(f"{terrain}: {first} moves {g:.2f} SE toward its bound < {WIN_SE:g}")
+    return not why, why
+
+
+def run_matrix(presets_dir: str | Path, names=None, runs: int = RUNS, terrains=None, map_tasks=None,
+               progress=None) -> dict:
+    """Every preset of ``names`` (default: :data:`PRESETS`) found in ``presets_dir`` (``NAME.json``)
+    against the defaults on ``terrains`` (default: :data:`TERRAINS`); the matrix (JSON-ready)."""
+    from planner._presets import load_preset
+    from planner._weights import ScoringWeights
+    from tuning._targets import load_tune_targets
+
+    names = tuple(names or PRESETS)
+    terrains = tuple(terrains or TERRAINS)
+    say = progress or (lambda *a: None)
+    defaults: dict = {}
+    out = {"terrains": {t: TERRAINS[t] for t in terrains}, "runs_per_cell": runs, "seed_base": SEED_BASE,
+           "spawns": list(SPAWNS), "main_metric": MAIN_METRIC, "win_se": WIN_SE, "loss_se": LOSS_SE, "presets": {}}
+    for name in names:
+        spec = PRESETS[name]
+        path = Path(presets_dir) / f"{name}.json"
+        if not path.exists():
+            out["presets"][name] = {"found": False, "passes": False, "why": [f"{path} not found"],
+                                    "command": spec["command"]}
+            continue
+        creature = spec["creature"]
+        preset = load_preset(path, creature)
+        if preset.weights == ScoringWeights() and (preset.timing is None or preset.timing == load_tune_targets(
+                _repo_path(spec["style"]) if "style" in spec else None, creature).timing()):
+            # Its tune accepted no candidate: the defaults against themselves would prove nothing.
+            rounds = preset.provenance.get("rounds", [])
+            last = rounds[-1]["line_search"] if rounds else []
+            out["presets"][name] = {
+                "found": True, "creature": creature, "kind": "terrain" if "terrain" in spec else "style",
+                "passes": False, "command": spec["command"], "weights_max_rel_change": 0.0, "cells": {},
+                "why": ["its tune kept the defaults: " + "; ".join(f"step x{t['alpha']:g}: {t['decision']}"
+                                                                 for t in last)]}
+            continue
+        # A style preset's cells are measured against its own targets (its clearance bound decides
+        # which touch-downs are near a box), the defaults too.
+        targets = load_tune_targets(_repo_path(spec["style"]) if "style" in spec else None, creature)
+        style = style_of(name)
+        cells = {}
+        for terrain in terrains:
+            setup = cell_setup(creature, terrain, runs)
+            key = (creature, terrain, spec.get("style"))
+            if key not in defaults:
+                say(f"{creature} defaults on {terrain}")
+                defaults[key] = event_metrics(setup, ScoringWeights(), targets.timing(), targets, map_tasks)
+            say(f"{name} on {terrain}")
+            mine = event_metrics(setup, preset.weights, preset.timing or targets.timing(), targets, map_tasks)
+            cells[terrain] = evaluate_cell(defaults[key], mine, style)
+        passes, why = verdict(name, cells, style)
+        w0 = ScoringWeights().to_array()
+        w = preset.weights.to_array()
+        out["presets"][name] = {
+            "found": True, "creature": creature, "kind": "terrain" if "terrain" in spec else "style",
+            "for": spec.get("terrain") or list(spec["terrains"]), "style": style, "command": spec["command"],
+            "sha256": hashlib.sha256(path.read_bytes()).hexdigest(),
+            "weights_max_rel_change": float(np.max(np.abs(w / w0 - 1.0))),
+            "passes": passes, "why": why, "cells": cells}
+    return _clean(out)
+
+
+def _clean(value):
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {k: _clean(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_clean(v) for v in value]
+    return value

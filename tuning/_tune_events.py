@@ -1,0 +1,353 @@
+"""Terrain and style tunes of the scoring weights (issue 18): ``footfall tune --scenarios ... --targets ...``.
+
+The legacy tune (:mod:`tuning._tune`) fits the gait timing to the stride law on a sweep of speeds;
+with the generic law it rightly keeps the defaults. This one tunes the **scoring weights** for a
+terrain or a style, the timing held at the targets file's stride law (so the runtime commands the
+law the per-stride error is measured against):
+
+Each outer round r (``rounds`` at most):
+
+1. **harvest** every couple the search could pick (``planner.harvest_situations``, seed ``seed + r``)
+   on the training scenarios, each spawned :data:`HARVEST_SPAWN` of the way along its route so the
+   situations meet the feature (risers, crates, slopes);
+2. **fit** the weights alone (:func:`tuning._fit.fit` with the weights' blocks, ``fit_timing=False``,
+   temperature :data:`TAU`): soft expectations of the offset from the preferred footprint and of the
+   style's quantities, with real gradients for every weight;
+3. **exact objective** (:mod:`tuning._events`) along the fitted step, a backtracking line search
+   (:data:`tuning._tune.LINE_SEARCH`): a candidate is accepted if it is finite, its collisions and
+   body overlaps do not rise over the defaults' (:func:`tuning._events.collisions_rise`), and lowers the paired per-run loss of the best so
+   far by at least ``gain_noise_se`` standard errors.
+
+Then the **held-out** runs: other terrains' parameters and other seeds (:func:`heldout_variant`,
+``holdout_seeds``), each paired run by run with the defaults. A tuned preset whose held-out loss is
+higher than the defaults' (a negative paired gain) is not shipped: the defaults are, and
+``heldout_refused`` says why.
+
+A checkpoint (JSON, atomic) after every round makes ``--resume`` continue to the same preset.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from footfall._atomic import write_text_atomic
+from footfall._errors import InputError
+from tuning._events import (EVENT_FRAMES, SPAWN_FRACTIONS, EventSetup, collisions_rise, event_metrics, paired,
+                            spawn_variant)
+from tuning._tune import (LINE_SEARCH, TuneResult, _bucket, _floats, _objects, _pad_problem, _towards, check_creature,
+                          check_output, checkpoint_path)
+
+CHECKPOINT_FORMAT = "footfall-tune-events-checkpoint"
+CHECKPOINT_VERSION = 1
+TAU = 0.01
+"""Temperature of the soft selection (:mod:`tuning._proxies`, 'Temperature')."""
+HARVEST_SPAWN = 0.3
+PRIOR_LOG_SCALE = 2.0
+"""The fit's prior on the log weights (:mod:`tuning._fit`): a factor e^2 costs one tolerance. Looser
+than the timing tune's 1.0: the exact line search has the last word on every step."""
+OFFSET_WEIGHT_STYLE = 0.0
+"""The offset block's weight in a style tune: off, the style's blocks lead (with it, every style
+tune first pulled the feet onto the preferred footprints, beside boxes too: collisions rose)."""
+GAIN_NOISE_SE = 2.0
+DEFAULT_SCENARIOS = ("stairs", "crates", "hills", "mixed")
+HELDOUT = {
+    "stairs": "stairs@terrain.rise=0.1,terrain.run=0.3",
+    "crates": "crates@seed=13",
+    "crates-moving": "crates-moving@seed=17",
+    "hills": "hills@seed=5",
+    "mixed": "mixed@seed=19",
+    "flat": "flat@crowd.speed=0.2",
+}
+"""Per built-in scenario, its held-out variant: other terrain parameters or another layout."""
+
+
+def heldout_variant(name: str) -> str:
+    """The held-out variant of a training scenario: :data:`HELDOUT` for a built-in, ``seed`` + 1000
+    for a variant or a file (another layout or terrain of the same kind)."""
+    if name in HELDOUT:
+        return HELDOUT[name]
+    base, sep, rest = name.partition("@")
+    extra = "seed=1000"
+    return f"{base}@{rest},{extra}" if sep and rest else f"{base}@{extra}"
+
+
+@dataclass(frozen=True)
+class EventTuneConfig:
+    creature: str
+    scenarios: tuple[str, ...] = DEFAULT_SCENARIOS
+    targets_file: str | None = None
+    rounds: int = 3
+    seed: int = 0
+    seeds: tuple[int, ...] = (0, 1, 2)
+    frames: int = EVENT_FRAMES
+    characters: int = 1
+    spawn_fractions: tuple[float, ...] = SPAWN_FRACTIONS
+    harvest_frames: int = 40
+    harvest_characters: int = 2
+    max_situations: int = 800
+    fit_steps: int = 12
+    tau: float = TAU
+    holdout_scenarios: tuple[str, ...] | None = None  # None: heldout_variant of each scenario
+    holdout_seeds: tuple[int, ...] = (101, 102, 103)
+    gain_noise_se: float = GAIN_NOISE_SE
+    prior_log_scale: float = PRIOR_LOG_SCALE
+
+    def __post_init__(self) -> None:
+        for name in ("scenarios", "seeds", "spawn_fractions", "holdout_seeds"):
+            object.__setattr__(self, name, tuple(getattr(self, name)))
+        if self.holdout_scenarios is not None:
+            object.__setattr__(self, "holdout_scenarios", tuple(self.holdout_scenarios))
+        if not self.scenarios:
+            raise InputError("argument", "--scenarios", "expected at least one scenario")
+        for name in ("rounds", "seed", "frames", "characters", "harvest_frames", "harvest_characters",
+                     "max_situations", "fit_steps"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or value < (0 if name == "seed" else 1):
+                raise InputError("argument", f"--{name}", f"expected a positive integer, got {value!r}")
+        if not self.tau > 0.0:
+            raise InputError("argument", "tau", f"expected > 0, got {self.tau}")
+
+    def setup(self) -> EventSetup:
+        return EventSetup(self.creature, self.scenarios, tuple(s + self.seed for s in self.seeds), self.frames,
+                          self.characters, self.spawn_fractions)
+
+    def holdout(self) -> EventSetup:
+        names = self.holdout_scenarios or tuple(heldout_variant(n) for n in self.scenarios)
+        return EventSetup(self.creature, names, tuple(s + self.seed for s in self.holdout_seeds), self.frames,
+                          self.characters, self.spawn_fractions)
+
+    def to_json(self) -> dict:
+        return {k: list(v) if isinstance(v, tuple) else v for k, v in dataclasses.asdict(self).items()}
+
+
+def check_scenarios(names) -> tuple[str, ...]:
+    """Every scenario loads (one line on the first that does not)."""
+    from scenarios import load_scenario
+
+    names = tuple(n.strip() for n in names if n.strip())
+    if not names:
+        raise InputError("argument", "--scenarios", "expected NAME[,NAME...]")
+    for name in names:
+        load_scenario(name)
+    return names
+
+
+def _start(targets) -> dict:
+    from planner._weights import ScoringWeights
+
+    return {"weights": _floats(ScoringWeights().to_array()), "timing": _floats(targets.timing().to_array())}
+
+
+def _fit_round(config: EventTuneConfig, params: dict, round_index: int, targets, map_tasks):
+    from planner._harvest import harvest_situations
+    from tuning._fit import fit, initial_params, loss, make_problem
+    from tuning._proxies import situations_from_harvest
+
+    weights, timing = _objects(params)
+    scenarios = tuple(spawn_variant(n, HARVEST_SPAWN) for n in config.scenarios)
+    harvest = harvest_situations(scenarios=scenarios, creatures=(config.creature,), seeds=(config.seed + round_index,),
+                                 frames=config.harvest_frames, n_characters=config.harvest_characters, weights=weights,
+                                 timing=timing, max_situations=config.max_situations, map_tasks=map_tasks)
+    situations = situations_from_harvest(harvest)
+    problem = make_problem(situations, harvest.creatures, {harvest.creatures[0]: targets}, config.tau,
+                           weights_blocks=True, fit_timing=False, offset_weight=OFFSET_WEIGHT_STYLE if targets.style
+                           else 1.0, prior_log_scale=config.prior_log_scale)
+    f, k, s = (int(x) for x in situations.couple_mask.shape)
+    problem = _pad_problem(problem, _bucket(f, 128), _bucket(k, 32), _bucket(s, 4))
+    loss0 = float(loss(initial_params(problem), problem))
+    w, _, history = fit(problem, n_steps=config.fit_steps)
+    record = {"situations": f, "proxy_loss_before": loss0, "proxy_loss_after": float(history[-1]),
+              "harvest_seed": config.seed + round_index}
+    return {"weights": _floats(w), "timing": params["timing"]}, record
+
+
+def accept(candidate: dict, best: dict, default: dict, gain_noise_se: float) -> tuple[bool, str]:
+    """(accepted, why) of a candidate's event metrics against the best so far and the defaults'."""
+    if not candidate["finite"]:
+        return False, "non-finite run"
+    rises, mean, se = collisions_rise(default, candidate)
+    if rises:
+        return False, f"more collisions and body overlaps than the defaults (+{mean:.3g} per run, SE {se:.3g})"
+    if not candidate["exact_loss"] < best["exact_loss"]:
+        return False, "loss did not improve"
+    gain, se, _ = paired(best, candidate)
+    if not gain >= gain_noise_se * se:
+        return False, f"gain within the runs' noise ({gain:.3g} < {gain_noise_se:g} x SE {se:.3g})"
+    return True, "improved"
+
+
+def _save(path: Path, state: dict) -> None:
+    write_text_atomic(path, json.dumps(state, indent=1, allow_nan=False, default=_json_default) + "\n")
+
+
+def _json_default(value):
+    raise TypeError(f"not JSON: {value!r}")
+
+
+def _clean(value):
+    """NaN -> None, recursively (JSON has no NaN)."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {k: _clean(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_clean(v) for v in value]
+    return value
+
+
+def _load(path: Path, config: EventTuneConfig) -> dict:
+    if not path.exists():
+        raise InputError(path, "checkpoint", "no checkpoint to resume from (run without --resume first)")
+    try:
+        state = json.loads(path.read_text())
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
+        raise InputError(path, "checkpoint", f"cannot read: {e}") from None
+    if not isinstance(state, dict) or state.get("format") != CHECKPOINT_FORMAT:
+        raise InputError(path, "format", f"corrupt: expected a {CHECKPOINT_FORMAT} file")
+    if state.get("version") != CHECKPOINT_VERSION:
+        raise InputError(path, "version", f"expected {CHECKPOINT_VERSION}, got {state.get('version')!r}")
+    if state.get("config") != config.to_json():
+        theirs = state.get("config") or {}
+        diff = sorted(k for k, v in config.to_json().items() if theirs.get(k) != v)
+        raise InputError(path, "config", f"the checkpoint was made with other settings ({', '.join(diff)})")
+    return state
+
+
+def weights_max_rel_change(tuned: dict, default: dict) -> float:
+    """max over the scoring weights and scales of |tuned / default - 1|."""
+    a = np.asarray(tuned["weights"], dtype=np.float64)
+    b = np.asarray(default["weights"], dtype=np.float64)
+    return float(np.max(np.abs(a / b - 1.0)))
+
+
+def tune_events(config: EventTuneConfig, out, resume: bool = False, progress=None, stop_after: int | None = None,
+                write: bool = True, workers: int | None = None, cluster: str | None = None,
+                spearman_candidates: int = 0, evaluate: bool = True) -> TuneResult:
+    """Run (or resume) the terrain / style tune; write the preset to ``out`` (module docstring).
+    ``spearman_candidates`` > 0: also validate the proxies on that many candidate presets
+    (:func:`tuning._validate.metric_change_spearman`). ``evaluate`` False: stop after the outer loop
+    (the checkpoint holds the result; ``footfall bench tuning --scenarios`` times the search alone)."""
+    from footfall._distribute import check_workers, task_runner
+
+    t0 = time.perf_counter()
+    check_workers(workers, cluster)
+    check_creature(config.creature)
+    out = check_output(out)
+    with task_runner(workers, cluster) as map_tasks:
+        return _run(config, out, resume, progress, stop_after, write, map_tasks, t0, spearman_candidates, evaluate)
+
+
+def _run(config, out, resume, progress, stop_after, write, map_tasks, t0, spearman_candidates,
+         evaluate=True) -> TuneResult:
+    from planner._presets import preset_dict
+    from scenarios import default_gait_name, load_creature
+    from tuning._config import enable_x64
+    from tuning._targets import load_tune_targets
+
+    enable_x64()
+    targets = load_tune_targets(config.targets_file, config.creature)
+    setup = config.setup()
+    ckpt = checkpoint_path(out)
+    say = progress or (lambda *a: None)
+    total = config.rounds + 2
+    start = _start(targets)
+    if resume:
+        state = _load(ckpt, config)
+        say(f"resumed at round {state['round']}", state["round"] + 1, total)
+    else:
+        say("objective of the defaults", 0, total)
+        default_exact = event_metrics(setup, *_objects(start), targets, map_tasks)
+        state = {"format": CHECKPOINT_FORMAT, "version": CHECKPOINT_VERSION, "config": config.to_json(), "round": 0,
+                 "stopped": False, "current": start, "best": {"params": start, "exact": default_exact, "round": -1},
+                 "default_exact": default_exact, "history": []}
+        _save(ckpt, _clean(state))
+    while state["round"] < config.rounds and not state["stopped"]:
+        r = state["round"]
+        say(f"round {r + 1}/{config.rounds}: harvest + fit", r + 1, total)
+        fitted, record = _fit_round(config, state["current"], r, targets, map_tasks)
+        say(f"round {r + 1}/{config.rounds}: exact runs", r + 1, total)
+        tried = []
+        for alpha in LINE_SEARCH:
+            params = _towards(state["current"], fitted, alpha)
+            candidate = event_metrics(setup, *_objects(params), targets, map_tasks)
+            accepted, why = accept(candidate, state["best"]["exact"], state["default_exact"], config.gain_noise_se)
+            tried.append({"alpha": alpha, "exact_loss": candidate["exact_loss"],
+                          "stride_rel_error": candidate["stride_rel_error"], "collisions": candidate["collisions"],
+                          "decision": why})
+            if accepted:
+                break
+        record.update(round=r, alpha=alpha, accepted=accepted, decision=why, line_search=tried)
+        state["history"].append(record)
+        if accepted:
+            state["best"] = {"params": params, "exact": candidate, "round": r}
+            state["current"] = params
+        else:
+            state["stopped"] = True
+        state["round"] = r + 1
+        state = _clean(state)
+        _save(ckpt, state)
+        if stop_after is not None and state["round"] >= stop_after:
+            return TuneResult(preset={}, summary={}, wall_s=time.perf_counter() - t0, finished=False)
+    if not evaluate:
+        return TuneResult(preset={}, summary={}, wall_s=time.perf_counter() - t0, finished=True)
+    say("held-out runs", total - 1, total)
+    best = state["best"]
+    holdout = config.holdout()
+    held_default = event_metrics(holdout, *_objects(start), targets, map_tasks)
+    held_tuned = held_default if best["round"] < 0 else event_metrics(holdout, *_objects(best["params"]), targets,
+                                                                      map_tasks)
+    gain, se, n = paired(held_default, held_tuned)
+    refused = None
+    if best["round"] >= 0 and not gain > 0.0:
+        refused = (f"round {best['round']} refused on the held-out runs: paired loss gain {gain:.4g} "
+                   f"(SE {se:.3g}, {n} runs) is not positive")
+        best = {"params": start, "exact": state["default_exact"], "round": -1}
+        held_tuned, gain, se = held_default, 0.0, math.nan
+    spearman = None
+    if spearman_candidates > 0:
+        from tuning._validate import metric_change_spearman
+
+        say("proxy validation", total - 1, total)
+        spearman = metric_change_spearman(config, targets, spearman_candidates, map_tasks)
+    weights, timing = _objects(best["params"])
+    from footfall import __version__
+
+    summary = {
+        "creature": config.creature,
+        "scenarios": list(config.scenarios),
+        "targets": targets.to_json(),
+        "heldout_scenarios": list(holdout.scenarios),
+        "loss_default": state["default_exact"]["exact_loss"], "loss_tuned": best["exact"]["exact_loss"],
+        "heldout_loss_default": held_default["exact_loss"], "heldout_loss_tuned": held_tuned["exact_loss"],
+        "heldout_gain_se": None if not (se > 0.0) else gain / se,
+        "heldout_runs": n,
+        "heldout_stride_error_default": held_default["stride_rel_error"],
+        "heldout_stride_error_tuned": held_tuned["stride_rel_error"],
+        "heldout_collisions_default": held_default["collisions"], "heldout_collisions_tuned": held_tuned["collisions"],
+        "weights_max_rel_change": weights_max_rel_change(best["params"], start),
+        "spearman_metric_change": None if spearman is None else spearman["spearman_min"],
+        "rounds_run": state["round"], "best_round": best["round"], "heldout_refused": refused,
+    }
+    provenance = {
+        "tool": "footfall tune (terrain / style)", "footfall_version": __version__,
+        "config": config.to_json(), "targets": targets.to_json(),
+        "fit": {"method": "optimistix.LevenbergMarquardt on the weights' blocks (tuning._fit), weights only, "
+                          "timing = the targets' stride law", "tau": config.tau},
+        "objective": "tuning._events: runs spawned along the route, per-event metrics, paired run losses",
+        "rounds": state["history"],
+        "heldout": {"default": _clean(held_default), "tuned": _clean(held_tuned)},
+        "spearman": spearman,
+        "summary": _clean(summary),
+    }
+    creature = load_creature(config.creature)
+    preset = preset_dict(creature.name, weights, timing, default_gait_name(creature), _clean(provenance))
+    if write:
+        write_text_atomic(out, json.dumps(preset, indent=1, allow_nan=False) + "\n")
+    return TuneResult(preset=preset, summary=_clean(summary), wall_s=time.perf_counter() - t0)
