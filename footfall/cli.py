@@ -755,10 +755,11 @@ elsewhere; a style preset with its style metric >= 2 SE toward its bound; neithe
         from pathlib import Path
 
         for name, p in matrix["presets"].items():
-            if p["found"] and not p["passes"]:
-                (Path(presets_dir) / f"{name}.json").unlink()
-                checkpoint = Path(presets_dir) / f"{name}.json.checkpoint.json"
-                checkpoint.unlink(missing_ok=True)
+            preset = Path(presets_dir) / f"{name}.json"
+            # A stored entry may name a preset pruned by an earlier run: nothing to remove then.
+            if p["found"] and not p["passes"] and preset.exists():
+                preset.unlink()
+                (Path(presets_dir) / f"{name}.json.checkpoint.json").unlink(missing_ok=True)
                 _err().print(f"footfall: note: {name} does not pass; removed from {presets_dir}", markup=False)
     if json_out:
         print(json.dumps(matrix))
