@@ -12,9 +12,6 @@ import pytest
 from benchmarks import tuning_bench as tb
 from footfall import InputError
 
-# Its module fixtures are built once: every test of the file runs on the same xdist worker.
-pytestmark = pytest.mark.xdist_group("test_bench_tuning")
-
 TINY = dict(exact_frames=60, harvest_frames=15, max_situations=80, froude=(0.01, 0.02), exact_scenarios=("flat",),
             fit_steps=3, exact_characters=1)
 MAX_EVALS = 6

@@ -10,9 +10,6 @@ from footfall._errors import InputError
 from footfall._distribute import check_workers, run_tasks
 from reports._sweep import PRESETS, build_tasks, run_task, without_timings
 
-# Its module fixtures are built once: every test of the file runs on the same xdist worker.
-pytestmark = pytest.mark.xdist_group("test_distributed")
-
 
 @pytest.fixture(scope="module")
 def quick_tasks():

@@ -12,9 +12,6 @@ import sys
 import numpy as np
 import pytest
 
-# Its module fixtures are built once: every test of the file runs on the same xdist worker.
-pytestmark = pytest.mark.xdist_group("test_report")
-
 CLI = [sys.executable, "-m", "footfall.cli"]
 HEADLESS = dict(os.environ, VTK_DEFAULT_OPENGL_WINDOW="vtkEGLRenderWindow")
 

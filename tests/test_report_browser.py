@@ -24,8 +24,7 @@ FPS = 30.0
 SIZE = (320, 240)
 CHROMIUM = shutil.which("chromium")
 
-pytestmark = [pytest.mark.skipif(CHROMIUM is None, reason="Debian chromium is not installed (.ci/run installs it)"),
-              pytest.mark.xdist_group("test_report_browser")]  # its module fixture is built once
+pytestmark = pytest.mark.skipif(CHROMIUM is None, reason="Debian chromium is not installed (.ci/run installs it)")
 
 # For every image and video: loaded? size, and the standard deviation of its pixels (a blank one has ~0).
 CHECK_SCRIPT = """<script>

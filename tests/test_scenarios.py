@@ -31,9 +31,6 @@ from scenarios import (
     stairs_heightfield,
 )
 
-# Its module fixtures are built once: every test of the file runs on the same xdist worker.
-pytestmark = pytest.mark.xdist_group("test_scenarios")
-
 SCENARIO_NAMES = ("crates", "crates-moving", "flat", "hills", "mixed", "stairs")
 CREATURE_LEGS = {
     "spider": ("L1", "L2", "L3", "L4", "R1", "R2", "R3", "R4"),

@@ -12,9 +12,6 @@ import pytest
 
 from footfall import InputError
 
-# Its module fixtures are built once: every test of the file runs on the same xdist worker.
-pytestmark = pytest.mark.xdist_group("test_tuning_events")
-
 ROOT = Path(__file__).resolve().parents[1]
 STYLES = ROOT / "tuning" / "data" / "styles"
 

@@ -6,9 +6,6 @@ import pytest
 from planner import GaitTiming, ScoringWeights, harvest_situations
 from planner._timing import GRAVITY, TIMING_FIELDS
 
-# Its module fixtures are built once: every test of the file runs on the same xdist worker.
-pytestmark = pytest.mark.xdist_group("test_tuning_fit")
-
 N_STEPS = 6
 TAU = 0.05
 # The stride residual recomputed here from the same float64 numbers (one division order apart).

@@ -8,9 +8,6 @@ from planner import _timing as runtime_timing
 from planner._timing import TIMING_FIELDS
 from planner._weights import WEIGHT_FIELDS
 
-# Its module fixtures are built once: every test of the file runs on the same xdist worker.
-pytestmark = pytest.mark.xdist_group("test_tuning_proxies")
-
 # At the harvest's timing the proxy recomputes the distance feature and d_ref with sqrt
 # instead of hypot: a few ulps on goodnesses in [0, 1] (see tests/test_tuning_scoring.py).
 AT_HARVEST_ATOL = 1e-12

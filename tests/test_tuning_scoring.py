@@ -13,9 +13,6 @@ import pytest
 from planner import FEATURES, RAW_METRICS, harvest_situations
 from planner._weights import FOOTPRINT_TERMS, N_FOOTPRINT_TERMS, SCORE_TERMS, TRAJECTORY_TERMS
 
-# Its module fixtures are built once: every test of the file runs on the same xdist worker.
-pytestmark = pytest.mark.xdist_group("test_tuning_scoring")
-
 MIN_CANDIDATE_SETS = 1000
 # The JAX and numba formulas are the same float64 operations on the same inputs; only the
 # order of a few operations may differ (XLA may turn a division by a broadcast weight into

@@ -12,9 +12,6 @@ import pytest
 from footfall import InputError
 from planner import load_preset
 
-# Its module fixtures are built once: every test of the file runs on the same xdist worker.
-pytestmark = pytest.mark.xdist_group("test_tuning_tune")
-
 PRESETS = Path(__file__).resolve().parents[1] / "tuning" / "data" / "presets"
 SHIPPED = ("spider", "ant", "quadruped", "robot5")
 SPEARMAN_MIN = 0.9  # issue 4 item 6

@@ -24,9 +24,6 @@ from reports._usd import (
 )
 from scenarios import builtin_creature_names, default_gait_name, load_creature, load_gait, load_scenario
 
-# Its module fixtures are built once: every test of the file runs on the same xdist worker.
-pytestmark = pytest.mark.xdist_group("test_usd")
-
 SCENARIO = "mixed"  # hills (a terrain that is not flat) and crates looping along waypoints
 CHARACTERS = 2
 FRAMES = 20
