@@ -30,6 +30,7 @@ Stages of a frame (timed one by one):
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import math
 import time
 from dataclasses import dataclass, field
@@ -584,17 +585,21 @@ def _with_neighbours_feet(model: CrowdModel, state: CrowdState, cs, own, preferr
     support = np.where(state.in_stance[..., None], state.feet, state.swing_target)[..., [0, 2]].reshape(-1, 2)
     owner = np.repeat(np.arange(n_chars), n_legs)
     radius = model.config.search_radius_m + 2.0 * math.hypot(model.creature.foot_length, model.creature.foot_width)
-    found = cKDTree(support).query_ball_point(preferred, radius)
-    near = [np.array(sorted(j for j in hits if owner[j] != c), dtype=np.int64) for c, hits in zip(cs, found)]
-    counts = k + np.array([x.size for x in near], dtype=np.int64)
+    found = cKDTree(support).query_ball_point(preferred, radius, return_sorted=True)
+    sizes = np.fromiter((len(x) for x in found), np.int64, f)
+    near = np.fromiter(itertools.chain.from_iterable(found), np.int64, int(sizes.sum()))
+    foot_of = np.repeat(np.arange(f), sizes)
+    keep = owner[near] != cs[foot_of]  # the other characters' feet only
+    near, foot_of = near[keep], foot_of[keep]
+    counts = np.bincount(foot_of, minlength=f)
     legs_start = np.zeros(f + 1, dtype=np.int64)
-    np.cumsum(counts, out=legs_start[1:])
+    np.cumsum(k + counts, out=legs_start[1:])
     legs = np.empty((legs_start[-1], 4))
-    for i in range(f):
-        a = legs_start[i]
-        legs[a:a + k] = own[i]
-        p = support[near[i]]
-        legs[a + k:legs_start[i + 1]] = np.column_stack([p, p])
+    legs[(legs_start[:-1, None] + np.arange(k)).ravel()] = own.reshape(-1, 4)
+    first = np.zeros(f, dtype=np.int64)
+    np.cumsum(counts[:-1], out=first[1:])
+    rows = legs_start[foot_of] + k + (np.arange(near.size) - first[foot_of])
+    legs[rows] = support[near][:, [0, 1, 0, 1]]
     return legs, legs_start
 
 
