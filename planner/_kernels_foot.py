@@ -48,13 +48,13 @@ OTHER_LEG = 3  # another leg's projection or another foot
 PAD = 4  # the padding ring around the ROI
 
 MIN_STEP_CELLS = 1e-3
+"""A candidate footprint closer to the foot than this (cells) is no step (and no path)."""
 # A footprint belongs to its own cell, borders included (footprint_point puts it on a border when the
 # preferred footprint lies beyond). The chord that ends at it is checked up to this far before it, so
 # that a cell it meets only at the footprint (the neighbour across the border, or the diagonal ones at
 # a corner) does not refuse the couple; the floor convention of cell_of would put such a footprint in
 # the neighbour, and whether it did depended on how (x - origin) / cell rounds.
 END_PULLBACK_M = 1e-9
-"""A candidate footprint closer to the foot than this (cells) is no step (and no path)."""
 MAX_SLICES = 12
 MAX_DENSE = 1024  # samples of one path; a longer path is refused
 DENSE_SPACING = 0.35  # target spacing of dense samples, in cells
