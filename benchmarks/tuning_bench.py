@@ -206,23 +206,21 @@ def exact_loss_of(setup, targets, x, start=None) -> tuple[float, str | None]:
     return loss, None
 
 
-def run_cmaes(setup, targets, target_loss: float, max_evals: int, seed: int, sigma0: float = SIGMA0,
-              progress=None, start=None) -> dict:
-    """Seeded CMA-ES (ask/tell) on the exact loss until a candidate's loss <= ``target_loss``,
-    ``max_evals`` evaluations, or CMA-ES's own stop. ``exact_evals`` = candidates evaluated
-    (a stop mid-population leaves the rest of that population unevaluated and uncounted).
-    The normal samples come from ``numpy.random.default_rng(seed)`` (CMA's ``randn`` option; its
-    ``seed`` option would reseed numpy's global generator, and reads 0 as "seed from the clock")."""
+def _cmaes_until(evaluate, x0, sigma0: float, seed: int, target: float, max_evals: int, bounds=None, say=None):
+    """Seeded CMA-ES (ask/tell) on ``evaluate(x) -> loss`` until a loss <= ``target``, ``max_evals``
+    evaluations, or CMA-ES's own stop. The normal samples come from ``numpy.random.default_rng(seed)``
+    (CMA's ``randn`` option; its ``seed`` option would reseed numpy's global generator, and reads 0 as
+    "seed from the clock"). Returns (losses in evaluation order, what stopped it, population size,
+    wall seconds)."""
     import cma
 
-    max_evals = _check_int("max_evals", max_evals, 1)
-    x0, lower, upper = search_space(start)
     rng = np.random.default_rng(seed)
     options = {"seed": np.nan, "randn": lambda *shape: rng.standard_normal(shape), "verbose": -9,
-               "verb_log": 0, "verb_disp": 0, "bounds": [list(lower), list(upper)]}
+               "verb_log": 0, "verb_disp": 0}
+    if bounds is not None:
+        options["bounds"] = [list(bounds[0]), list(bounds[1])]
     es = cma.CMAEvolutionStrategy(x0, sigma0, options)
     history: list[float] = []
-    invalid = 0
     stopped_by = "max_evals"
     t0 = time.perf_counter()
     while len(history) < max_evals:
@@ -232,24 +230,43 @@ def run_cmaes(setup, targets, target_loss: float, max_evals: int, seed: int, sig
         candidates = es.ask()
         losses = []
         for x in candidates:
-            loss, why = exact_loss_of(setup, targets, x, start)
-            invalid += why is not None
+            loss = evaluate(x)
             history.append(loss)
             losses.append(loss)
-            if progress:
-                progress(f"CMA-ES {len(history)}/{max_evals}: best {min(history):.4g} (target {target_loss:.4g})")
-            if loss <= target_loss or len(history) >= max_evals:
+            if say:
+                say(f"CMA-ES {len(history)}/{max_evals}: best {min(history):.4g} (target {target:.4g})")
+            if loss <= target or len(history) >= max_evals:
                 break
-        if history[-1] <= target_loss:
+        if history[-1] <= target:
             stopped_by = "target"
             break
         if len(losses) == len(candidates):
             es.tell(candidates, losses)
-    wall = time.perf_counter() - t0
+    return history, stopped_by, es.popsize, time.perf_counter() - t0
+
+
+def run_cmaes(setup, targets, target_loss: float, max_evals: int, seed: int, sigma0: float = SIGMA0,
+              progress=None, start=None) -> dict:
+    """Seeded CMA-ES (ask/tell) on the exact loss until a candidate's loss <= ``target_loss``,
+    ``max_evals`` evaluations, or CMA-ES's own stop. ``exact_evals`` = candidates evaluated
+    (a stop mid-population leaves the rest of that population unevaluated and uncounted), seeded
+    as :func:`_cmaes_until` says."""
+    max_evals = _check_int("max_evals", max_evals, 1)
+    x0, lower, upper = search_space(start)
+    invalid = 0
+
+    def evaluate(x):
+        nonlocal invalid
+        loss, why = exact_loss_of(setup, targets, x, start)
+        invalid += why is not None
+        return loss
+
+    history, stopped_by, popsize, wall = _cmaes_until(evaluate, x0, sigma0, seed, target_loss, max_evals,
+                                                      bounds=(lower, upper), say=progress)
     best = min(history)
     return {"wall_s": float(wall), "exact_evals": len(history), "exact_loss": float(best),
             "reached": bool(best <= target_loss), "stopped_by": stopped_by, "invalid_evals": int(invalid),
-            "popsize": int(es.popsize), "sigma0": float(sigma0), "dimension": int(x0.size),
+            "popsize": int(popsize), "sigma0": float(sigma0), "dimension": int(x0.size),
             "history": [float(v) for v in history]}
 
 
@@ -343,8 +360,6 @@ def run_events(creature: str, scenarios, seed: int = 0, max_evals: int = DEFAULT
 
     The tune's acceptance guards stay on (collisions, noise): the comparison is to the loss of the
     preset the tune writes. One untimed evaluation of the defaults warms the planner first."""
-    import cma
-
     from planner._weights import ScoringWeights
     from tuning._config import enable_x64
     from tuning._events import event_metrics
@@ -376,37 +391,17 @@ def run_events(creature: str, scenarios, seed: int = 0, max_evals: int = DEFAULT
              "start_exact_loss": float(state["default_exact"]["exact_loss"]), "rounds_run": len(line_search),
              "accepted_rounds": sum(bool(r["accepted"]) for r in state["history"])}
     x0 = np.log(ScoringWeights().to_array())
-    rng = np.random.default_rng(config.seed)
-    es = cma.CMAEvolutionStrategy(x0, SIGMA0, {"seed": np.nan, "randn": lambda *shape: rng.standard_normal(shape),
-                                               "verbose": -9, "verb_log": 0, "verb_disp": 0})
-    history: list[float] = []
-    stopped_by = "max_evals"
-    t0 = time.perf_counter()
-    while len(history) < max_evals:
-        if es.stop():
-            stopped_by = "cma: " + ", ".join(sorted(es.stop()))
-            break
-        candidates = es.ask()
-        losses = []
-        for x in candidates:
-            try:
-                loss = float(event_metrics(setup, ScoringWeights.from_array(np.exp(x)), timing, targets)["exact_loss"])
-            except ValueError:
-                loss = INVALID_LOSS
-            history.append(loss)
-            losses.append(loss)
-            say(f"CMA-ES {len(history)}/{max_evals}: best {min(history):.4g} (target {target:.4g})")
-            if loss <= target or len(history) >= max_evals:
-                break
-        if history[-1] <= target:
-            stopped_by = "target"
-            break
-        if len(losses) == len(candidates):
-            es.tell(candidates, losses)
-    wall = time.perf_counter() - t0
+
+    def evaluate(x):
+        try:
+            return float(event_metrics(setup, ScoringWeights.from_array(np.exp(x)), timing, targets)["exact_loss"])
+        except ValueError:
+            return INVALID_LOSS
+
+    history, stopped_by, popsize, wall = _cmaes_until(evaluate, x0, SIGMA0, config.seed, target, max_evals, say=say)
     best = min(history)
     cmaes = {"wall_s": float(wall), "exact_evals": len(history), "exact_loss": float(best),
-             "reached": bool(best <= target), "stopped_by": stopped_by, "popsize": int(es.popsize),
+             "reached": bool(best <= target), "stopped_by": stopped_by, "popsize": int(popsize),
              "sigma0": SIGMA0, "dimension": int(x0.size), "history": [float(v) for v in history]}
     return {"creature": creature, "scenarios": list(config.scenarios), "seed": config.seed, "rounds": rounds,
             "max_evals": max_evals, "target_loss": target, "proxy": proxy, "cmaes": cmaes,
