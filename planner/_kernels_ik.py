@@ -459,25 +459,37 @@ def _descend(b, lengths, limits, azimuth_limits, df, du, dl, alpha, pair_steps, 
     return residual, used, False
 
 
-@nb.njit(cache=True)
-def _solve_one(b, hips, rotations, rest_azimuths, lengths, limits, azimuth_limits, targets, warm, cold, restarts,
-               pair_steps, max_iterations, tolerance, out_angles, out_residual, out_iterations, out_joints):
-    """CCD with restarts for leg ``b`` (module docstring); writes row ``b`` of every output."""
-    n_seg = lengths.shape[1]
-    q = out_angles
-    # target relative to the hip, in body (forward, up, left) coordinates
+@nb.njit(cache=True, inline="always")
+def _target_in_body(b, hips, rotations, targets):
+    """Leg ``b``'s target relative to its hip, in body (forward, up, left) coordinates."""
     ex = targets[b, 0] - hips[b, 0]
     ey = targets[b, 1] - hips[b, 1]
     ez = targets[b, 2] - hips[b, 2]
     df = rotations[b, 0, 0] * ex + rotations[b, 1, 0] * ey + rotations[b, 2, 0] * ez
     du = rotations[b, 0, 1] * ex + rotations[b, 1, 1] * ey + rotations[b, 2, 1] * ez
     dl = rotations[b, 0, 2] * ex + rotations[b, 1, 2] * ey + rotations[b, 2, 2] * ez
-    alpha = rest_azimuths[b]
+    return df, du, dl
 
-    # warm start, brought into the limits (replaced by the nearest grid pose when cold)
+
+@nb.njit(cache=True, inline="always")
+def _warm_into_limits(b, q, warm, limits, azimuth_limits, n_seg):
+    """Row ``b`` of ``q``: the warm start brought into the azimuth and joint limits."""
     q[b, 0] = nearest_in_limits(warm[b, 0], -azimuth_limits[b], azimuth_limits[b])
     for j in range(n_seg):
         q[b, j + 1] = nearest_in_limits(warm[b, j + 1], limits[b, j, 0], limits[b, j, 1])
+
+
+@nb.njit(cache=True)
+def _solve_one(b, hips, rotations, rest_azimuths, lengths, limits, azimuth_limits, targets, warm, cold, restarts,
+               pair_steps, max_iterations, tolerance, out_angles, out_residual, out_iterations, out_joints):
+    """CCD with restarts for leg ``b`` (module docstring); writes row ``b`` of every output."""
+    n_seg = lengths.shape[1]
+    q = out_angles
+    df, du, dl = _target_in_body(b, hips, rotations, targets)
+    alpha = rest_azimuths[b]
+
+    # warm start, brought into the limits (replaced by the nearest grid pose when cold)
+    _warm_into_limits(b, q, warm, limits, azimuth_limits, n_seg)
     levels = seed_levels(n_seg)
     seed_dist = -1.0
     seed_code = -1
@@ -643,16 +655,9 @@ def _two_bone_one(b, hips, rotations, rest_azimuths, lengths, limits, azimuth_li
     """The analytic solve of leg ``b`` (:func:`solve_legs_two_bone_serial`); writes row ``b``."""
     n_seg = lengths.shape[1]
     q = out_angles
-    ex = targets[b, 0] - hips[b, 0]
-    ey = targets[b, 1] - hips[b, 1]
-    ez = targets[b, 2] - hips[b, 2]
-    df = rotations[b, 0, 0] * ex + rotations[b, 1, 0] * ey + rotations[b, 2, 0] * ez
-    du = rotations[b, 0, 1] * ex + rotations[b, 1, 1] * ey + rotations[b, 2, 1] * ez
-    dl = rotations[b, 0, 2] * ex + rotations[b, 1, 2] * ey + rotations[b, 2, 2] * ez
+    df, du, dl = _target_in_body(b, hips, rotations, targets)
     alpha = rest_azimuths[b]
-    q[b, 0] = nearest_in_limits(warm[b, 0], -azimuth_limits[b], azimuth_limits[b])
-    for j in range(n_seg):
-        q[b, j + 1] = nearest_in_limits(warm[b, j + 1], limits[b, j, 0], limits[b, j, 1])
+    _warm_into_limits(b, q, warm, limits, azimuth_limits, n_seg)
     chain = np.empty((n_seg + 1, N_CHAIN), dtype=np.float64)
     _chain_from(b, lengths, q, 0, chain)
     fx = chain[n_seg, CH_X]
