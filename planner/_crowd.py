@@ -549,6 +549,12 @@ def _reach_xz(model: CrowdModel) -> np.ndarray:
     return np.sqrt(np.maximum(reach**2 - dy**2, (0.2 * reach) ** 2))
 
 
+def _foot_room(model: CrowdModel) -> float:
+    """m, the room a planned foot keeps from every other foot (the search's ``block_radius``): the
+    foot's diagonal."""
+    return math.hypot(model.creature.foot_length, model.creature.foot_width)
+
+
 def _same_frame_conflicts(model: CrowdModel, cs, targets, valid) -> np.ndarray:
     """(F,) bool: valid plans whose target lies within a foot's room of an earlier valid plan's target
     of another character (this frame's plans)."""
@@ -558,7 +564,7 @@ def _same_frame_conflicts(model: CrowdModel, cs, targets, valid) -> np.ndarray:
     from scipy.spatial import cKDTree
 
     idx = np.flatnonzero(valid)
-    radius = math.hypot(model.creature.foot_length, model.creature.foot_width)
+    radius = _foot_room(model)
     pairs = cKDTree(targets[idx][:, [0, 2]]).query_pairs(radius, output_type="ndarray")
     if pairs.size:
         a, b = idx[pairs[:, 0]], idx[pairs[:, 1]]
@@ -584,7 +590,7 @@ def _with_neighbours_feet(model: CrowdModel, state: CrowdState, cs, own, preferr
 
     support = np.where(state.in_stance[..., None], state.feet, state.swing_target)[..., [0, 2]].reshape(-1, 2)
     owner = np.repeat(np.arange(n_chars), n_legs)
-    radius = model.config.search_radius_m + 2.0 * math.hypot(model.creature.foot_length, model.creature.foot_width)
+    radius = model.config.search_radius_m + 2.0 * _foot_room(model)
     found = cKDTree(support).query_ball_point(preferred, radius, return_sorted=True)
     sizes = np.fromiter((len(x) for x in found), np.int64, f)
     near = np.fromiter(itertools.chain.from_iterable(found), np.int64, int(sizes.sum()))
@@ -925,7 +931,7 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
         hips=np.ascontiguousarray(hip_pred), reach_xz=_reach_xz(model)[ls],
         step_height=np.full(f, model.step_height),
         legs=legs, legs_start=legs_start,
-        block_radius=np.full(f, math.hypot(model.creature.foot_length, model.creature.foot_width)),
+        block_radius=np.full(f, _foot_room(model)),
         couples_after_first=couples[cs], slice_size=slices[cs],
         # the paper's early termination (§5.2) always, unless a fixed budget says otherwise
         early=np.full(f, model.fixed_budget is None or model.fixed_budget.paper_early_stop, np.bool_))
