@@ -651,9 +651,13 @@ def _stance_unreachable_ahead(model: CrowdModel, state: CrowdState, hips, freque
     shifted = hips[cs, ls].copy()
     shifted[:, 0] += ahead * np.cos(state.heading[cs])
     shifted[:, 2] += ahead * np.sin(state.heading[cs])
-    # The pelvis keeps rising (or sinking) as it did over the last frame; rising is what
-    # stretches a stance leg, so only a rise is carried forward.
-    shifted[:, 1] += (horizon / model.dt) * np.maximum(state.pelvis_rise[cs], 0.0)
+    # Rising is what stretches a stance leg, so only a rise is carried forward: the last frame's,
+    # and on up the slope the body walks (its pitch), at most the last frame's rise every frame.
+    # Carrying a one-frame jump (a foot lifted off the hull's low side) on every frame of the
+    # horizon predicted a rise of several cm that never came, and held the body: robot5 walked
+    # up `hills` at 57 % of its asked speed at Fr 0.05, and every creature lost speed on `stairs`.
+    rise = np.maximum(state.pelvis_rise[cs], 0.0)
+    shifted[:, 1] += np.minimum((horizon / model.dt) * rise, rise + ahead * np.maximum(np.tan(state.pitch[cs]), 0.0))
     # A far character (LOD) looks ahead with its own IK, the two-bone solve.
     two_bone = _two_bone_characters(model, state)[cs]
     for far in (False, True) if two_bone.any() else (False,):
@@ -673,7 +677,16 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, fre
     state.sector_missed &= ~state.in_stance
     kinds = np.zeros(state.in_stance.shape, dtype=np.int8)
     kinds[state.wants_swing & state.in_stance] = 1
-    far = np.hypot(state.feet[..., 0] - hips[..., 0], state.feet[..., 2] - hips[..., 2]) > _reach_xz(model)[None, :]
+    # A stance foot beyond its leg's horizontal reach steps, unless it is ahead of its hip and the
+    # body walks (at least half its goal speed) toward it, so it comes back into reach (the IK
+    # look-ahead below still holds a body whose leg cannot follow). Forcing those feet, just landed
+    # ahead of a body slowed on a hill, made robot5's front legs step twice a cycle (strides 40-60 %
+    # off the law). A body turning on the spot does not walk toward them, nor does one near a moving
+    # box: it turns away from the box, off the heading the foot is ahead along.
+    walking = (state.speed >= 0.5 * np.minimum(state.desired_speed, state.speed_limit)) & ~moving_box_near(model, state)
+    ahead = walking[:, None] & (((state.feet[..., 0] - hips[..., 0]) * np.cos(state.heading)[:, None]
+                                 + (state.feet[..., 2] - hips[..., 2]) * np.sin(state.heading)[:, None]) > 0.0)
+    far = (np.hypot(state.feet[..., 0] - hips[..., 0], state.feet[..., 2] - hips[..., 2]) > _reach_xz(model)[None, :]) & ~ahead
     cannot_follow = _stance_unreachable_ahead(model, state, hips, frequency)
     # A stance foot at the rear end of its window steps now: the body cannot move on without it
     # (stance_speed_cap holds the body back), and its sector may be a cycle away.

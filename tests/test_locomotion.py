@@ -104,15 +104,17 @@ def test_the_schedule_moves_up_and_down_with_hysteresis():
 # --------------------------------------------------------------------------- what a walker realises
 # Every built-in creature at three speeds spanning its range (Froude numbers 0.05, 0.2, 0.5), one
 # character on flat ground from a fresh start; fixed seeds plus a fresh one each session
-# (conftest.fresh_seeds; a seed that ever failed joins FIXED_SEEDS). This is a ratchet under what
-# the runtime holds today (issue 13's bars, median <= 5 %, p90 <= 15 %, speed within 5 %, are
-# measured by ``python -m benchmarks.locomotion_bench``; they are not met everywhere yet): a change
-# that makes any creature's strides or legs worse than this fails.
+# (conftest.fresh_seeds; a seed that ever failed joins FIXED_SEEDS). Issue 13's bars per stride:
+# on flat median <= 5 %, p90 <= 15 %; on hills median <= 10 %, p90 <= 25 %. The speed bar (within
+# 5 % on flat) is measured by ``python -m benchmarks.locomotion_bench``: the spider at Fr 0.2 reaches
+# 94.6-95.9 % of it over seeds 0-9, so the test holds 93 % (a change that slows any creature fails).
 from conftest import fresh_seeds  # noqa: E402
 
 FIXED_SEEDS = (0, 1)
+HILLS_SEEDS = (0, 2, 5)  # robot5 at Fr 0.05 failed the p90 bar on seeds 0, 2 and 5 before issue 13's fixes
 FROUDE = (0.05, 0.2, 0.5)
-RATCHET = dict(median=0.08, p90=0.35, reached=0.65)
+FLAT_BARS = dict(median=0.05, p90=0.15, reached=0.93)
+HILLS_BARS = dict(median=0.10, p90=0.25)
 
 
 def _walk(creature_name, scenario_name, froude, seed, frames=300):
@@ -138,12 +140,29 @@ def test_every_creature_walks_its_speed_range_on_flat_ground(creature_name):
             where = f"{creature_name} at Fr {froude}, seed {seed}: {s}"
             goal = min(s.speed_asked, s.speed_cap or math.inf)
             assert s.strides_measured >= 10, where
-            assert s.stride_rel_error_median <= RATCHET["median"], where
-            assert s.stride_rel_error_p90 <= RATCHET["p90"], where
-            assert s.speed_reached >= RATCHET["reached"] * goal, where
+            assert s.stride_rel_error_median <= FLAT_BARS["median"], where
+            assert s.stride_rel_error_p90 <= FLAT_BARS["p90"], where
+            assert s.speed_reached >= FLAT_BARS["reached"] * goal, where
             assert s.ik_residual_p95_m <= 2e-3, where
-            if froude <= 0.2:  # at Fr 0.5 stance feet still slip by up to 4 cm at times (issue 13, open)
-                assert s.max_stance_slip_m <= 1e-3, where
+            assert s.max_stance_slip_m <= 1e-3, where
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("creature_name", ("spider", "ant", "quadruped", "robot5"))
+def test_every_creature_walks_its_speed_range_on_hills(creature_name):
+    # Up and across the slopes of `hills`: strides follow the law, legs reach their feet, stance feet
+    # stay put. (robot5 at Fr 0.05 used to crawl up at 57 % of its speed, strides 33-61 % off at p90:
+    # a one-frame rise of the pelvis carried over the whole look-ahead held the body, and front feet
+    # just landed ahead of a slowed body were forced to step again.)
+    for seed in fresh_seeds(HILLS_SEEDS, 1, salt=7 * sum(map(ord, creature_name))):
+        for froude in FROUDE:
+            s = _walk(creature_name, "hills", froude, seed)
+            where = f"{creature_name} on hills at Fr {froude}, seed {seed}: {s}"
+            assert s.strides_measured >= 10, where
+            assert s.stride_rel_error_median <= HILLS_BARS["median"], where
+            assert s.stride_rel_error_p90 <= HILLS_BARS["p90"], where
+            assert s.ik_residual_p95_m <= 2e-3, where
+            assert s.max_stance_slip_m <= 1e-3, where
 
 
 def test_duty_factor_falls_with_speed_and_the_quadruped_trots_when_fast():
