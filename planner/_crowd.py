@@ -1273,7 +1273,10 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
     # The swing's lift stays well inside what the legs reach (half the highest step): a foot
     # lifted to the edge of its workspace mid-swing leaves the IK no continuous way there.
     step_height = min(controller.step_height_factor * float(creature.standing_height), 0.5 * highest)
-    if raster is None or (obstacles is not scenario.obstacles and raster.obstacles is scenario.obstacles):
+    # A raster given for reuse is rebuilt unless its boxes are these, compared by value: compared by
+    # identity, a raster cached from an earlier load of the same scenario kept its tall safe boxes
+    # walkable, so the first run in a process differed from every later one.
+    if raster is None or not _same_boxes(raster.obstacles, obstacles):
         raster = WorldRaster.build(scenario.terrain, obstacles, config.cell_size)
     if abs(raster.frame.cell_size - config.cell_size) > 1e-12:
         raise ValueError(f"raster: cell size {raster.frame.cell_size} differs from the planner's {config.cell_size}")
@@ -1346,6 +1349,22 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
     state.pose_before = _pose(state)  # nothing to take back before the first frame
     stage_ik(model, state, np.ones(n, np.bool_))
     return model, state
+
+
+def _same_boxes(a, b) -> bool:
+    """Whether two obstacle sets hold the same boxes, moving the same way (every array equal)."""
+    import dataclasses
+
+    if a is b:
+        return True
+    for field in dataclasses.fields(a):
+        x, y = getattr(a, field.name), getattr(b, field.name)
+        if isinstance(x, (list, tuple)):
+            if len(x) != len(y) or not all(np.array_equal(u, v) for u, v in zip(x, y)):
+                return False
+        elif not np.array_equal(np.asarray(x), np.asarray(y)):
+            return False
+    return True
 
 
 def _too_tall_forbidden(obstacles, highest: float):

@@ -93,6 +93,24 @@ def test_same_seed_same_recording(tmp_path):
     assert header["format"] == "footfall-recording" and header["version"] == 1
 
 
+def test_a_raster_given_for_reuse_gives_the_run_it_would_have_without_it():
+    # A raster built from a scenario's boxes, passed to a crowd of the same scenario loaded again: its
+    # safe boxes too tall for the spider are forbidden all the same. (Checked by identity, the reused
+    # raster kept them walkable: the first run in a process, which built its raster, differed from
+    # every later one that reused it.)
+    creature = load_creature("spider")
+    gait = load_gait(default_gait_name("spider"), creature)
+    first = load_scenario("crates-moving")
+    raster = WorldRaster.build(first.terrain, first.obstacles, planner_config_for(creature).cell_size)
+    again = load_scenario("crates-moving")
+    reused, _ = init_crowd(again, creature, gait, n_characters=3, seed=4, raster=raster)
+    built, _ = init_crowd(again, creature, gait, n_characters=3, seed=4)
+    tall = np.asarray(built.raster.obstacles.forbidden) & ~np.asarray(again.obstacles.forbidden)
+    assert tall.any(), "premise: crates-moving has a safe box too tall for the spider"
+    np.testing.assert_array_equal(reused.raster.obstacles.forbidden, built.raster.obstacles.forbidden)
+    np.testing.assert_array_equal(reused.raster.static_forbidden, built.raster.static_forbidden)
+
+
 def _cli(*args):
     return subprocess.run([sys.executable, "-m", "footfall.cli", *args], capture_output=True, text=True, timeout=600)
 
