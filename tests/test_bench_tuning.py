@@ -12,6 +12,8 @@ import pytest
 from benchmarks import tuning_bench as tb
 from footfall import InputError
 
+pytestmark = pytest.mark.slow  # tuning benches (about 10 s)
+
 TINY = dict(exact_frames=60, harvest_frames=15, max_situations=80, froude=(0.01, 0.02), exact_scenarios=("flat",),
             fit_steps=3, exact_characters=1)
 MAX_EVALS = 6

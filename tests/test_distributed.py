@@ -10,6 +10,8 @@ from footfall._errors import InputError
 from footfall._distribute import check_workers, run_tasks
 from reports._sweep import PRESETS, build_tasks, run_task, without_timings
 
+pytestmark = pytest.mark.slow  # worker processes (about 20 s)
+
 
 @pytest.fixture(scope="module")
 def quick_tasks():

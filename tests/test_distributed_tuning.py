@@ -17,6 +17,8 @@ from planner import GaitTiming, ScoringWeights
 from planner._harvest import Harvest, _harvest_batch, _pack, harvest_chunk, harvest_situations, harvest_tasks
 from tuning._exact import ExactSetup, exact_metrics
 
+pytestmark = pytest.mark.slow  # worker processes (about 12 s)
+
 # Tiny runs: 2 characters so that some frames plan several feet (a cap can fall inside a frame).
 HARVEST = dict(scenarios=("flat", "hills"), creatures=("spider",), seeds=(0, 1), frames=12, n_characters=3)
 EXACT = ExactSetup("spider", scenarios=("flat", "hills"), frames=60, froude=(0.01, 0.02), n_characters=1)

@@ -8,11 +8,13 @@ import subprocess
 import sys
 
 import numpy as np
+import pytest
 
 CLI = [sys.executable, "-m", "footfall.cli"]
 HEADLESS = dict(os.environ, VTK_DEFAULT_OPENGL_WINDOW="vtkEGLRenderWindow")
 
 
+@pytest.mark.slow  # the whole main job (about 60 s)
 def test_run_writes_every_output_into_one_folder(tmp_path):
     from planner import load_preset
     from pxr import Usd, UsdSkel

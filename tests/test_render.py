@@ -11,6 +11,8 @@ import sys
 import numpy as np
 import pytest
 
+pytestmark = pytest.mark.slow  # pyvista renders in subprocesses (about 25 s)
+
 CLI = [sys.executable, "-m", "footfall.cli"]
 HEADLESS = dict(os.environ, VTK_DEFAULT_OPENGL_WINDOW="vtkEGLRenderWindow")
 CREATURE_KEYS = ("joints", "rotations", "body_size", "leg_radius")

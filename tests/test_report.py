@@ -43,6 +43,7 @@ def _image_stats(path):
 # ----------------------------------------------------------------------------- the quick report
 
 
+@pytest.mark.slow  # the quick report (about 35 s)
 def test_quick_report_writes_a_complete_folder(quick):
     out, summary = quick
     for name in ("index.html", "results.csv", "summary.csv", "paired.csv", "results.json", "pareto.png",
@@ -55,6 +56,7 @@ def test_quick_report_writes_a_complete_folder(quick):
     assert summary["render_errors"] == []
 
 
+@pytest.mark.slow  # the quick report (about 35 s)
 def test_csv_and_json_agree(quick):
     out, summary = quick
     data = json.loads((out / "results.json").read_text())
@@ -87,6 +89,7 @@ def test_csv_and_json_agree(quick):
     assert data["rows"] == summary["rows"]
 
 
+@pytest.mark.slow  # the quick report (about 35 s)
 def test_pareto_front_and_recommended_budget(quick):
     from reports._pareto import COST, LOSS, dominates
 
@@ -113,6 +116,7 @@ def test_pareto_front_and_recommended_budget(quick):
         assert r["paired_cost_ci_low"] <= r[COST] <= r["paired_cost_ci_high"], r["setting"]
 
 
+@pytest.mark.slow  # the quick report (about 35 s)
 def test_lod_section_has_scaling_and_quality_per_level(quick):
     from reports._lod_report import LEVEL_TABLE
 
@@ -132,6 +136,7 @@ def test_lod_section_has_scaling_and_quality_per_level(quick):
         assert (out / name).is_file(), name
 
 
+@pytest.mark.slow  # the quick report (about 35 s)
 def test_exhaustive_search_is_never_beaten(quick):
     out, _ = quick
     data = json.loads((out / "results.json").read_text())
@@ -152,11 +157,13 @@ def test_exhaustive_search_is_never_beaten(quick):
         assert by["budget-cinf-s0.10"][key] == by["lod-off"][key], key
 
 
+@pytest.mark.slow  # the quick report (about 35 s)
 def test_fig13_situation_is_the_crowds_plan(quick):
     _, summary = quick
     assert summary["scenes"] and all(s["heatmap_matches_crowd"] for s in summary["scenes"])
 
 
+@pytest.mark.slow  # the quick report (about 35 s)
 def test_report_pictures_are_not_blank(quick):
     out, summary = quick
     pictures = [out / "pareto.png", out / "stride.png"] + sorted(out.glob("gait_disks_*.png")) \
@@ -167,6 +174,7 @@ def test_report_pictures_are_not_blank(quick):
         assert std > 8.0 and colours > 16 and dark < 0.5, (p.name, std, colours, dark)
 
 
+@pytest.mark.slow  # the quick report (about 35 s)
 def test_index_leads_with_a_short_table_and_keeps_the_full_one_behind_a_toggle(quick):
     out, summary = quick
     page = (out / "index.html").read_text(encoding="utf-8")
@@ -273,6 +281,7 @@ window.addEventListener('load', function () {
 </script>"""
 
 
+@pytest.mark.slow  # the quick report (about 35 s)
 @pytest.mark.skipif(shutil.which("chromium") is None, reason="Debian chromium is not installed")
 def test_every_image_loads_in_headless_chromium(quick, tmp_path):
     out, _ = quick
@@ -296,6 +305,7 @@ def test_every_image_loads_in_headless_chromium(quick, tmp_path):
     assert result["broken"] == []
 
 
+@pytest.mark.slow  # the quick report (about 35 s)
 def test_the_reports_clips_play_in_headless_chromium(quick, tmp_path):
     # The real report page (not a page made for the test): every <video> loads, lasts at least 60 frames
     # (2 s at 30 fps) and shows a picture in its middle; every image is not blank.

@@ -24,7 +24,7 @@ FPS = 30.0
 SIZE = (320, 240)
 CHROMIUM = shutil.which("chromium")
 
-pytestmark = pytest.mark.skipif(CHROMIUM is None, reason="Debian chromium is not installed (.ci/run installs it)")
+pytestmark = [pytest.mark.slow, pytest.mark.skipif(CHROMIUM is None, reason="Debian chromium is not installed (.ci/run installs it)")]
 
 # For every image and video: loaded? size, and the standard deviation of its pixels (a blank one has ~0).
 CHECK_SCRIPT = """<script>

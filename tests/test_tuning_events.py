@@ -232,6 +232,7 @@ def tiny_tunes(tmp_path_factory):
     return folder, config, whole, killed, resumed
 
 
+@pytest.mark.slow  # tiny terrain tunes (about 15 s)
 def test_a_tiny_terrain_tune_writes_a_preset_with_the_issues_json_keys(tiny_tunes):
     from planner import load_preset
 
@@ -251,6 +252,7 @@ def test_a_tiny_terrain_tune_writes_a_preset_with_the_issues_json_keys(tiny_tune
         assert whole.summary["weights_max_rel_change"] > 0.0
 
 
+@pytest.mark.slow  # tiny terrain tunes (about 15 s)
 def test_a_killed_terrain_tune_resumes_to_the_same_preset(tiny_tunes):
     folder, _, whole, killed, resumed = tiny_tunes
     assert not killed.finished
@@ -258,6 +260,7 @@ def test_a_killed_terrain_tune_resumes_to_the_same_preset(tiny_tunes):
     assert resumed.summary == whole.summary
 
 
+@pytest.mark.slow  # tiny terrain tunes (about 15 s)
 def test_a_checkpoint_of_other_settings_is_refused(tiny_tunes):
     from tuning._tune_events import tune_events
 

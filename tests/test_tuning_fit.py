@@ -106,6 +106,7 @@ def _targets():
     return tuning.load_targets(creatures=("spider", "ant"))
 
 
+@pytest.mark.slow  # jit-compiled fits (about 7 s each)
 def test_levenberg_marquardt_lowers_the_loss_and_keeps_parameters_valid(problem):
     from tuning import _fit
 
@@ -175,6 +176,7 @@ def _weights_jacobian(problem):
     return f, y0[0], np.asarray(jax.jacfwd(f)(y0[0]))
 
 
+@pytest.mark.slow  # jit-compiled fits (about 7 s each)
 def test_at_the_defaults_only_the_weights_blocks_give_the_weights_a_gradient(terrain_problems):
     from planner._weights import N_TERMS
 

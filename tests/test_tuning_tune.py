@@ -46,6 +46,7 @@ def tiny_runs(tmp_path_factory):
     return folder, config, whole, killed, after_kill, resumed
 
 
+@pytest.mark.slow  # tiny tunes (about 40 s)
 def test_a_tiny_run_writes_a_valid_preset(tiny_runs):
     folder, config, whole, _, _, _ = tiny_runs
     preset = load_preset(folder / "whole.json", "spider")
@@ -61,6 +62,7 @@ def test_a_tiny_run_writes_a_valid_preset(tiny_runs):
     assert 1 <= whole.summary["rounds_run"] <= config.rounds
 
 
+@pytest.mark.slow  # tiny tunes (about 40 s)
 def test_a_killed_run_resumes_to_the_same_preset(tiny_runs):
     folder, _, whole, killed, after_kill, resumed = tiny_runs
     assert not killed.finished
@@ -69,6 +71,7 @@ def test_a_killed_run_resumes_to_the_same_preset(tiny_runs):
     assert resumed.summary == whole.summary
 
 
+@pytest.mark.slow  # tiny tunes (about 40 s)
 def test_a_mis_tuned_start_is_reported_beside_the_defaults(tiny_runs, tmp_path):
     """--start-timing: the search starts from the mis-tuned timing, the *_start keys report it, and
     the *_default keys still mean the runtime's defaults (the same numbers as a run without a start)."""
@@ -87,6 +90,7 @@ def test_a_mis_tuned_start_is_reported_beside_the_defaults(tiny_runs, tmp_path):
     assert losses["start"]["exact_loss"] == summary["exact_loss_start"]
 
 
+@pytest.mark.slow  # tiny tunes (about 40 s)
 def test_bad_checkpoints_and_arguments_are_refused(tiny_runs, tmp_path):
     from tuning._tune import checkpoint_path, tune
 
@@ -103,6 +107,7 @@ def test_bad_checkpoints_and_arguments_are_refused(tiny_runs, tmp_path):
         tune(_tiny().__class__("octopus"), tmp_path / "o.json", workers=1)
 
 
+@pytest.mark.slow  # tiny tunes (about 40 s)
 def test_cli_refuses_bad_input_with_one_line():
     for args, field in ((["--creature", "octopus"], "--creature"),
                         (["--creature", "spider", "--out", "/proc/nope/spider.json"], "--out"),
@@ -189,6 +194,7 @@ def test_a_shipped_preset_is_the_defaults_exactly_when_its_tune_accepted_no_cand
     assert losses["heldout_tuned"]["stride_rel_error"] <= losses["heldout_default"]["stride_rel_error"]
 
 
+@pytest.mark.slow  # a tiny tune (about 10 s)
 def test_a_tune_that_accepts_no_candidate_keeps_the_defaults(tmp_path, monkeypatch):
     """Every step refused (here by a stand-in for the exact planner's verdict): the preset is the
     defaults bit for bit, and its held-out numbers are those of the defaults (the runs are deterministic)."""
@@ -206,6 +212,7 @@ def test_a_tune_that_accepts_no_candidate_keeps_the_defaults(tmp_path, monkeypat
 
 
 
+@pytest.mark.slow  # a tiny tune (about 10 s)
 def test_a_tuned_preset_that_walks_worse_on_the_held_out_runs_is_not_shipped(tmp_path, monkeypatch):
     """Every step accepted on the training runs, but the held-out runs (a stand-in for the exact planner
     there) find the tuned parameters' stride error higher than the defaults': the defaults ship, with the
