@@ -1358,6 +1358,8 @@ def _same_boxes(a, b) -> bool:
     if a is b:
         return True
     for field in dataclasses.fields(a):
+        if field.name.startswith("_"):  # derived from the others (and the poses' memo)
+            continue
         x, y = getattr(a, field.name), getattr(b, field.name)
         if isinstance(x, (list, tuple)):
             if len(x) != len(y) or not all(np.array_equal(u, v) for u, v in zip(x, y)):

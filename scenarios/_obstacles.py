@@ -54,6 +54,9 @@ class Obstacles:
     waypoint_speed: np.ndarray | None = None
     # Per box with motion kind 2: cumulative arc length at each waypoint, closing segment included ((k + 1,)).
     _loop_lengths: tuple[np.ndarray, ...] = field(init=False, repr=False)
+    # The last few poses asked for, by time: a crowd asks for the same few times several times a frame
+    # (now, the last frame, the threat horizon), and a looping box's pose is a Python search.
+    _poses_memo: dict = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         centres = frozen_array(_rows_of_3(self.centres), "centres", (None, 3))
@@ -113,6 +116,7 @@ class Obstacles:
         object.__setattr__(self, "waypoints", tuple(points))
         object.__setattr__(self, "waypoint_speed", speeds)
         object.__setattr__(self, "_loop_lengths", tuple(loops))
+        object.__setattr__(self, "_poses_memo", {})
 
     @classmethod
     def empty(cls) -> Obstacles:
@@ -137,12 +141,17 @@ class Obstacles:
         starting from waypoint 0 at t = 0. Returns fresh, writable arrays.
         """
         t = finite_float(t, "t")
-        centres = np.array(self.centres)
-        moving = self.motion_kind == VELOCITY
-        centres[moving] += t * self.velocities[moving]
-        for i in np.flatnonzero(self.motion_kind == WAYPOINTS):
-            centres[i] = _point_on_loop(self.waypoints[i], self._loop_lengths[i], self.waypoint_speed[i] * t)
-        return centres, np.array(self.yaws)
+        memo = self._poses_memo
+        if t not in memo:
+            centres = np.array(self.centres)
+            moving = self.motion_kind == VELOCITY
+            centres[moving] += t * self.velocities[moving]
+            for i in np.flatnonzero(self.motion_kind == WAYPOINTS):
+                centres[i] = _point_on_loop(self.waypoints[i], self._loop_lengths[i], self.waypoint_speed[i] * t)
+            if len(memo) >= 8:
+                memo.clear()
+            memo[t] = centres
+        return memo[t].copy(), np.array(self.yaws)
 
 
 def _rows_of_3(value: object) -> object:
