@@ -55,6 +55,7 @@ MIN_STEP_CELLS = 1e-3
 # a corner) does not refuse the couple; the floor convention of cell_of would put such a footprint in
 # the neighbour, and whether it did depended on how (x - origin) / cell rounds.
 END_PULLBACK_M = 1e-9
+PUSH_BEYOND_M = 1e-9  # a footprint pushed out of another foot's room ends this far beyond it (out_of_other_feet)
 MAX_SLICES = 12
 MAX_DENSE = 1024  # samples of one path; a longer path is refused
 DENSE_SPACING = 0.35  # target spacing of dense samples, in cells
@@ -245,6 +246,56 @@ def _near_other_foot(x, z, other_legs, feet_block_radius):
 
 
 @nb.njit(cache=True)
+def _nearest_on_leg(x, z, leg, whole_leg):
+    """The point of another leg (hip -> foot; its foot only unless ``whole_leg``) nearest to (x, z)."""
+    if not whole_leg:
+        return leg[2], leg[3]
+    dx = leg[2] - leg[0]
+    dz = leg[3] - leg[1]
+    ll = dx * dx + dz * dz
+    t = 1.0
+    if ll > 0.0:
+        t = min(1.0, max(0.0, ((x - leg[0]) * dx + (z - leg[1]) * dz) / ll))
+    return leg[0] + t * dx, leg[1] + t * dz
+
+
+@nb.njit(cache=True)
+def out_of_other_feet(x, z, cx, cz, cell, other_legs, feet_block_radius, whole_legs):
+    """(ok, x, z): a footprint within ``feet_block_radius`` of another foot (with ``whole_legs``, of
+    another leg, hip -> foot) moves straight away from the nearest one to just beyond that radius; ok
+    when the point then lies in the cell's closed square (centre (cx, cz)) and keeps the radius from
+    every foot (and leg). A footprint clear of them stays as it is.
+
+    Rejecting the whole cell instead put feet that follow close behind another foot (a metachronal
+    wave's legs) a cell or two short of their stride: the dodecapod's rear legs strode 30-60 % short.
+    """
+    nearest = -1
+    best = feet_block_radius
+    qx = qz = 0.0
+    for j in range(other_legs.shape[0]):  # the nearest, the first of equals
+        ax, az = _nearest_on_leg(x, z, other_legs[j], whole_legs)
+        d = math.hypot(x - ax, z - az)
+        if d <= feet_block_radius and (nearest < 0 or d < best):
+            best = d
+            nearest = j
+            qx, qz = ax, az
+    if nearest < 0:
+        return True, x, z
+    if best <= 1e-12:
+        return False, x, z
+    scale = (feet_block_radius + PUSH_BEYOND_M) / best
+    nx, nz = qx + (x - qx) * scale, qz + (z - qz) * scale
+    h = 0.5 * cell
+    if abs(nx - cx) > h or abs(nz - cz) > h:
+        return False, x, z
+    for j in range(other_legs.shape[0]):
+        ax, az = _nearest_on_leg(nx, nz, other_legs[j], whole_legs)
+        if math.hypot(nx - ax, nz - az) <= feet_block_radius:
+            return False, x, z
+    return True, nx, nz
+
+
+@nb.njit(cache=True)
 def footprint_point(cx, cz, cell, pref_x, pref_z):
     """The footprint of the cell centred at (cx, cz): the point of its closed square nearest to
     the preferred footprint (so the preferred footprint itself when it lies in the cell). Strides
@@ -297,6 +348,12 @@ def footprint_candidates(code, elev_dil, elev_raw, r0, c0, hp, wp, origin_x, ori
             if math.hypot(cx - pref_x, cz - pref_z) > radius:
                 continue  # the candidate disc is a set of cells (paper Fig. 13)
             x, z = footprint_point(cx, cz, cell, pref_x, pref_z)
+            # A cell touched by another leg: only the preferred footprint's own cell (below).
+            if code[p] == OTHER_LEG and (x != pref_x or z != pref_z):
+                continue
+            ok, x, z = out_of_other_feet(x, z, cx, cz, cell, other_legs, feet_block_radius, code[p] == OTHER_LEG)
+            if not ok:
+                continue
             if math.hypot(x - source_x, z - source_z) < MIN_STEP_CELLS * cell:
                 continue  # a foot on a cell border: the neighbour's nearest point may be where it stands
             if math.hypot(x - hip_x, z - hip_z) > reach_xz:
@@ -304,10 +361,11 @@ def footprint_candidates(code, elev_dil, elev_raw, r0, c0, hp, wp, origin_x, ori
             if not footprint_features(p, x, z, elev_dil, elev_raw, prox_dt, wp, pref_x, pref_z, hip_x, hip_z,
                                       other_legs, cell, feat):
                 continue
-            # ... only the cell of the preferred footprint itself (the one a blocked cell costs most):
-            # opening every such cell doubled the candidates and the planning cost.
-            if code[p] == OTHER_LEG and (x != pref_x or z != pref_z or not _clear_of_other_feet(
-                    x, z, other_legs, feat[FEAT_LEG_GAP], feet_block_radius)):
+            # ... only the cell of the preferred footprint itself (the one a blocked cell costs most;
+            # opening every such cell doubled the candidates and the planning cost), its footprint
+            # moved out of the other legs' room (out_of_other_feet) and keeping it both ways.
+            if code[p] == OTHER_LEG and not _clear_of_other_feet(x, z, other_legs, feat[FEAT_LEG_GAP],
+                                                                  feet_block_radius):
                 continue
             # A free cell next to the cells around another foot: its continuous footprint (on the border
             # nearest the preferred one) can still be within a foot's room of that foot.

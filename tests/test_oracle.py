@@ -10,7 +10,9 @@ documented definitions (the field docs of ``planner/_weights.py``, the docstring
 * the foot-shape stencil, the 'size increase' and the dilated elevations (paper Fig. 12);
 * the other legs' projections and the other feet as blocked cells (§4, §5.1);
 * the potential footprints and their continuous points (the preferred footprint when it lies in
-  the cell, else the cell's point nearest to it), the five footprint features and goodnesses;
+  the cell, else the cell's point nearest to it; a point within a foot's room of another foot, or
+  in the preferred footprint's own cell under another leg within a foot's room of that leg, moved
+  straight out of that room), the five footprint features and goodnesses;
 * the elevation slices (§5.2), the passable cells of each, the distance to blocked cells (the
   documented chamfer metric: octile distance between cell centres) and the potential field;
 * the wavefront as scipy's Dijkstra, with *every* shortest path enumerated (ties between equal
@@ -58,6 +60,7 @@ SQRT2 = math.sqrt(2.0)
 # Documented constants of the path construction (planner/_kernels_foot.py's module constants and
 # docstrings), restated here rather than imported.
 MIN_STEP_CELLS = 1e-3  # a footprint closer to the source than this (cells) is no step
+PUSH_BEYOND_M = 1e-9  # a footprint moved out of another foot's room ends this far beyond it
 DENSE_SPACING = 0.35  # target spacing of the Hermite samples (cells)
 DENSE_SPACING_MAX = 0.40  # no chord between samples longer than this (cells)
 JERK_SAMPLES = 48  # constant arc-length samples of the jerk integral
@@ -106,6 +109,37 @@ def point_segment_distance(px, pz, ax, az, bx, bz):
     ap = np.array([px - ax, pz - az])
     t = 0.0 if ab @ ab == 0 else min(1.0, max(0.0, float(ap @ ab) / float(ab @ ab)))
     return float(math.hypot(ax + t * ab[0] - px, az + t * ab[1] - pz))
+
+
+def nearest_on_segment(px, pz, ax, az, bx, bz):
+    """The point of segment a-b nearest to p."""
+    ab = np.array([bx - ax, bz - az])
+    t = 0.0 if ab @ ab == 0 else min(1.0, max(0.0, float(np.array([px - ax, pz - az]) @ ab) / float(ab @ ab)))
+    return ax + t * ab[0], az + t * ab[1]
+
+
+def pushed_out(x, z, cx, cz, half, legs, radius, whole_legs):
+    """A footprint within ``radius`` of another foot (``whole_legs``: of another leg's hip -> foot
+    segment) moved straight away from the nearest one to ``radius`` + PUSH_BEYOND_M; None when that
+    leaves the cell's closed square or comes within ``radius`` of another. (The documented rule of
+    ``out_of_other_feet``.)"""
+    def nearest(px, pz, leg):
+        a, b, fx, fz = leg
+        return nearest_on_segment(px, pz, a, b, fx, fz) if whole_legs else (fx, fz)
+
+    near = [(math.hypot(x - qx, z - qz), qx, qz) for qx, qz in (nearest(x, z, leg) for leg in legs)]
+    near = [n for n in near if n[0] <= radius]
+    if not near:
+        return x, z
+    d, qx, qz = min(near, key=lambda n: n[0])  # the first of equals
+    if d <= 1e-12:
+        return None
+    nx, nz = qx + (x - qx) * (radius + PUSH_BEYOND_M) / d, qz + (z - qz) * (radius + PUSH_BEYOND_M) / d
+    if abs(nx - cx) > half or abs(nz - cz) > half:
+        return None
+    if any(math.hypot(nx - qx2, nz - qz2) <= radius for qx2, qz2 in (nearest(nx, nz, leg) for leg in legs)):
+        return None
+    return nx, nz
 
 
 def proper_crossing(a, b, c, d):
@@ -284,6 +318,13 @@ class Oracle:
                 if math.hypot(cx - px, cz - pz) > self.cfg.search_radius_m:
                     continue  # the candidate disc is a set of cells (their centres in the disc)
                 tx, tz = min(max(px, cx - h), cx + h), min(max(pz, cz - h), cz + h)
+                other_leg_cell = self.code[r, c] == OTHER_LEG
+                if other_leg_cell and (tx, tz) != (px, pz):
+                    continue  # a cell under another leg: only the preferred footprint's own
+                moved = pushed_out(tx, tz, cx, cz, h, legs, radius, other_leg_cell)
+                if moved is None:
+                    continue
+                tx, tz = moved
                 if math.hypot(tx - self.src_x, tz - self.src_z) < MIN_STEP_CELLS * cell:
                     continue
                 if math.hypot(tx - hip_x, tz - hip_z) > q.reach_xz:
@@ -293,10 +334,9 @@ class Oracle:
                 gap = min([min(point_segment_distance(tx, tz, a, b, fx, fz),
                                point_segment_distance(fx, fz, hip_x, hip_z, tx, tz)) for a, b, fx, fz in legs],
                           default=math.inf)
-                if self.code[r, c] == OTHER_LEG:
-                    # Only the preferred footprint's own cell, and only with a foot's room from every leg and foot.
-                    if (tx, tz) != (px, pz) or gap < radius or any(math.hypot(tx - fx, tz - fz) <= radius
-                                                                   for _, _, fx, fz in legs):
+                if other_leg_cell:
+                    # ... and with a foot's room from every leg and foot, both ways.
+                    if gap < radius or any(math.hypot(tx - fx, tz - fz) <= radius for _, _, fx, fz in legs):
                         continue
                 if any(math.hypot(tx - fx, tz - fz) <= radius for _, _, fx, fz in legs):
                     continue  # within a foot's room of another foot (whatever its cell)

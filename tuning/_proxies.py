@@ -47,7 +47,8 @@ feature d_k = |x_k - P| of every candidate (closeness goodness) and the length
 goodness's reference d_ref,k = max(|x_k - source|, cell). The expected step length therefore depends on
 theta through the probabilities and the continuous footprints: each candidate's
 footprint x_k is its cell's point nearest P (:func:`footprints`, the runtime's
-``footprint_point``), so it follows P inside its cell; the source and every other
+``footprint_point``; moved out of another foot's room as the runtime moved it), so it
+follows P inside its cell; the source and every other
 raw number are the harvest's, held fixed. This is a local model, valid
 while P stays well inside the harvested candidate disc (the runtime would re-centre
 the disc on the new P and plan new paths); a fit should re-harvest between
@@ -209,10 +210,17 @@ def _norm(dx, dz):
 
 def footprints(situations: Situations, pref):
     """(F, K, 2) the candidates' continuous footprints for preferred footprints ``pref`` (F, 2): each
-    cell's point nearest P (planner._kernels_foot.footprint_point); = the harvest's at theta_0."""
+    cell's point nearest P (planner._kernels_foot.footprint_point); = the harvest's at theta_0.
+
+    A footprint the runtime moved out of another foot's room (planner._kernels_foot.out_of_other_feet:
+    the harvest's point is not its cell's point nearest P) keeps that move and follows P with it, the
+    other legs being held at theta_0."""
     s = situations
     half = 0.5 * s.cell_size[:, None, None]
-    return jnp.clip(pref[:, None, :], s.cand_centre - half, s.cand_centre + half)
+    nearest = jnp.clip(pref[:, None, :], s.cand_centre - half, s.cand_centre + half)
+    nearest0 = jnp.clip(s.preferred[:, None, :], s.cand_centre - half, s.cand_centre + half)
+    moved = jnp.any(s.cand_xz != nearest0, axis=-1, keepdims=True)
+    return jnp.where(moved, s.cand_xz + (nearest - nearest0), nearest)
 
 
 def moved_paths(situations: Situations, x):
