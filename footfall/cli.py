@@ -440,7 +440,7 @@ footprints. The crowd is the scenario's (its size unless --characters).
                              "cannot change it")
         run = load_recording(recording)
         s = load_scenario(scenario or run.scenario or "mixed")
-        c = load_creature(creature or run.creature)
+        c = load_creature(creature) if creature else run.load_creature()
         if frames is not None:
             run = run.head(frames)
     else:

@@ -127,6 +127,8 @@ class Recorder:
                   + [f"term_{i}" for i in range(N_TERMS)]
                   + ["couples_evaluated", "couples_2d", "cells_expanded", "wavefronts", "candidates", "slices",
                      "slice_level_m"], **meta}
+        if model.creature.source_toml is not None:  # a user's creature file travels with its recording
+            header["creature_toml"] = model.creature.source_toml
         with atomic_path(path, suffix=".npz") as tmp:
             with open(tmp, "wb") as fh:
                 np.savez_compressed(fh, header=np.array(json.dumps(header)), events=events, **self.arrays)

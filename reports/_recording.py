@@ -80,6 +80,15 @@ class Recording:
     def creature(self) -> str:
         return str(self.header["creature"])
 
+    def load_creature(self):
+        """The recorded creature: a built-in by name, or the user's creature file the recording carries."""
+        from scenarios import load_creature, load_creature_text
+
+        text = self.header.get("creature_toml")
+        if isinstance(text, str):
+            return load_creature_text(text, f"{self.path}:creature_toml")
+        return load_creature(self.creature)
+
     @property
     def leg_names(self) -> tuple[str, ...]:
         return tuple(self.header["leg_names"])

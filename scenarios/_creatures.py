@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -62,6 +62,9 @@ class Creature:
     body_thickness: float
     body_box: np.ndarray
     standing_height: float
+    # The creature file's text when it was loaded from a user's file (None for a built-in): a
+    # recording carries it, so that it can be rendered and exported without the file.
+    source_toml: str | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name.strip():

@@ -81,17 +81,24 @@ def _resolve(name_or_path: str | Path, directory: Path, builtins: tuple[str, ...
     raise InputError(text, what, f"unknown {what}; built-ins are: {', '.join(builtins)}")
 
 
-def _read_toml(path: Path, file: str, what: str) -> dict[str, Any]:
+def _read_text(path: Path, file: str, what: str) -> str:
     try:
-        text = path.read_bytes().decode("utf-8")
+        return path.read_bytes().decode("utf-8")
     except OSError as error:
         raise InputError(file, what, f"cannot read file: {one_line(error.strerror or error)}") from None
     except UnicodeDecodeError:
         raise InputError(file, what, "not UTF-8 text") from None
+
+
+def _parse_toml(text: str, file: str, what: str) -> dict[str, Any]:
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
         raise InputError(file, what, f"invalid TOML: {one_line(error)}") from None
+
+
+def _read_toml(path: Path, file: str, what: str) -> dict[str, Any]:
+    return _parse_toml(_read_text(path, file, what), file, what)
 
 
 _INDEXED = re.compile(r"^(\w+)((?:\[\d+\])*)$")
@@ -168,11 +175,16 @@ def load_creature(name_or_path: str | Path) -> Creature:
     Raises :class:`InputError` naming the file and field on any problem.
     """
     path, file = _resolve(name_or_path, CREATURES_DIR, builtin_creature_names(), "creature")
-    return _load_creature_file(path, file)
+    return _creature_from_text(_read_text(path, file, "creature"), path.stem, file)
 
 
-def _load_creature_file(path: Path, file: str) -> Creature:
-    model: schema.CreatureFile = schema.validate(schema.CreatureFile, _read_toml(path, file, "creature"), file)
+def load_creature_text(text: str, label: str) -> Creature:
+    """A creature from the text of a creature file (a recording's ``creature_toml``); errors name ``label``."""
+    return _creature_from_text(text, Path(label).stem, label)
+
+
+def _creature_from_text(text: str, stem: str, file: str) -> Creature:
+    model: schema.CreatureFile = schema.validate(schema.CreatureFile, _parse_toml(text, file, "creature"), file)
     if not model.legs:
         raise InputError(file, "legs", "creature needs at least one leg")
     defaults = model.leg_defaults
@@ -217,7 +229,7 @@ def _load_creature_file(path: Path, file: str) -> Creature:
 
     try:
         creature = Creature(
-            name=model.name or path.stem,
+            name=model.name or stem,
             leg_names=tuple(leg.name for leg in model.legs),
             hips=[leg.hip for leg in model.legs],
             segment_lengths=segments,
@@ -228,6 +240,7 @@ def _load_creature_file(path: Path, file: str) -> Creature:
             body_thickness=model.body_thickness,
             body_box=model.body_box,
             standing_height=model.standing_height,
+            source_toml=None if file.startswith("builtin:") else text,
         )
     except InputError as error:
         if error.file != UNATTRIBUTED:
@@ -406,7 +419,7 @@ def _crowd_creature(reference: str, base: Path, file: str) -> tuple[str, Creatur
     if reference in names:
         return reference, load_creature(reference)
     path = _file_next_to(reference, base, file, "crowd.creature", "creature", f"built-ins are: {', '.join(names)}")
-    return str(path), _load_creature_file(path, str(path))
+    return str(path), _creature_from_text(_read_text(path, str(path), "creature"), path.stem, str(path))
 
 
 def _file_next_to(reference: str, base: Path, file: str, field: str, kind: str, known: str) -> Path:

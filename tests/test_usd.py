@@ -213,6 +213,33 @@ def test_cli_exports_a_recording(run, tmp_path):
     assert len([p for p in stage.Traverse() if p.IsA(UsdSkel.Skeleton)]) == CHARACTERS
 
 
+def test_a_recording_of_a_users_creature_exports_without_its_file(tmp_path):
+    # The recording carries the creature file's text: the file may be gone (or never shipped along).
+    import shutil
+    from pathlib import Path
+
+    creature = tmp_path / "my-heptapod.toml"
+    shutil.copy(Path(__file__).parents[1] / "scenarios" / "examples" / "heptapod.toml", creature)
+    recording = tmp_path / "run.npz"
+    proc = _cli("simulate", "flat", "--creature", str(creature), "--characters", "1", "--frames", "6",
+                "--record", str(recording))
+    assert proc.returncode == 0, proc.stderr
+    creature.unlink()
+    out = tmp_path / "scene.usda"
+    proc = _cli("export-usd", "--recording", str(recording), "--out", str(out))
+    assert proc.returncode == 0, proc.stderr
+    stage = Usd.Stage.Open(str(out))
+    assert any(p.IsA(UsdSkel.Skeleton) for p in stage.Traverse())
+    from reports._recording import load_recording
+    from scenarios import load_creature
+
+    loaded = load_recording(recording).load_creature()
+    shipped = load_creature(str(Path(__file__).parents[1] / "scenarios" / "examples" / "heptapod.toml"))
+    assert loaded.name == "heptapod" and loaded.n_legs == 7
+    np.testing.assert_array_equal(loaded.hips, shipped.hips)
+    np.testing.assert_array_equal(loaded.rest_feet, shipped.rest_feet)
+
+
 def test_cli_unknown_scenario(tmp_path):
     line = _one_line_exit_2(_cli("export-usd", "no-such-place", "--out", str(tmp_path / "x.usda")))
     assert "no-such-place" in line
