@@ -614,15 +614,15 @@ def _solve_feet(model: CrowdModel, state: CrowdState, cs, ls, hips, iterations: 
     """CCD (or, with ``two_bone``, the closed-form solve of far characters) for legs (cs, ls)
     reaching for their feet from ``hips``, warm-started from the current angles (the one IK call
     of the controller's look-ahead and IK stages)."""
-    from planner._ik import solve_legs
+    from planner._ik import solve_legs_trusted
 
     legs = model.leg_static
     state.counters["ik_two_bone_legs" if two_bone else "ik_ccd_legs"] += int(cs.size)
     # The body poses as (yaw, pitch, roll): rotations built from angles need no orthonormality check.
     pose = np.column_stack([state.heading[cs], state.pitch[cs], state.roll[cs]])
-    return solve_legs(hips, pose, legs.rest_azimuths[ls], legs.segment_lengths[ls], legs.limits[ls],
-                      legs.azimuth_limits[ls], state.feet[cs, ls], warm_start=state.angles[cs, ls],
-                      max_iterations=iterations, restarts=restarts, two_bone=two_bone)
+    return solve_legs_trusted(hips, pose, legs.rest_azimuths[ls], legs.segment_lengths[ls], legs.limits[ls],
+                              np.broadcast_to(legs.azimuth_limits, legs.rest_azimuths.shape)[ls],
+                              state.feet[cs, ls], state.angles[cs, ls], iterations, restarts, two_bone=two_bone)
 
 
 def _stance_unreachable_ahead(model: CrowdModel, state: CrowdState, hips, frequency) -> np.ndarray:

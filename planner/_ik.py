@@ -225,18 +225,38 @@ def solve_legs(hips, body_rotations, rest_azimuths, segment_lengths, limits, azi
         raise ValueError(f"tolerance: expected a number of metres, got {tolerance!r}") from None
     if not (np.isfinite(tol) and tol >= 0.0):
         raise ValueError(f"tolerance: expected a finite number >= 0, got {tolerance!r}")
+    if two_bone and cold:
+        raise ValueError("warm_start: the two-bone solve starts from a pose (got None)")
+    return _solve(hips, rotations, rest, lengths, lim, az, targets, warm, cold, max_iterations, restarts, tol,
+                  parallel, bool(pair_steps), two_bone)
+
+
+def solve_legs_trusted(hips, body_angles, rest_azimuths, segment_lengths, limits, azimuth_limits, targets,
+                       warm_start, max_iterations: int, restarts: int, two_bone: bool = False) -> IKResult:
+    """:func:`solve_legs` (parallel, pair steps, default tolerance, warm started) without checking its
+    arguments: for the runtime's own arrays, checked once when the crowd was built (the checks cost
+    about 0.1 ms a call, a few calls a frame). ``body_angles`` (B, 3) are (yaw, pitch, roll) and
+    ``azimuth_limits`` is (B,); every array must already be float64."""
+    rotations = body_rotation(body_angles[:, 0], body_angles[:, 1], body_angles[:, 2])
+    c = np.ascontiguousarray
+    return _solve(c(hips), rotations, c(rest_azimuths), c(segment_lengths), c(limits), c(azimuth_limits),
+                  c(targets), np.array(warm_start, dtype=np.float64, order="C"), False, int(max_iterations),
+                  int(restarts), DEFAULT_TOLERANCE, True, True, two_bone)
+
+
+def _solve(hips, rotations, rest, lengths, lim, az, targets, warm, cold, max_iterations, restarts, tol, parallel,
+           pair_steps, two_bone) -> IKResult:
+    n, s = lengths.shape
     angles = np.empty((n, s + 1))
     residual = np.empty(n)
     iterations = np.empty(n, dtype=np.int64)
     joints = np.empty((n, s + 2, 3))
     if two_bone:
-        if cold:
-            raise ValueError("warm_start: the two-bone solve starts from a pose (got None)")
         kernel = solve_legs_two_bone_parallel if parallel else solve_legs_two_bone_serial
         kernel(hips, rotations, rest, lengths, lim, az, targets, warm, tol, angles, residual, iterations, joints)
     else:
         kernel = solve_legs_parallel if parallel else solve_legs_serial
-        kernel(hips, rotations, rest, lengths, lim, az, targets, warm, cold, restarts, bool(pair_steps),
+        kernel(hips, rotations, rest, lengths, lim, az, targets, warm, cold, restarts, pair_steps,
                max_iterations, tol, angles, residual, iterations, joints)
     return IKResult(angles=angles, residual=residual, iterations=iterations, converged=residual < tol,
                     joints=joints)
