@@ -1383,12 +1383,15 @@ def _too_tall_forbidden(obstacles, highest: float):
 
 
 def _initial_feet(model: CrowdModel, positions, headings):
-    """Rest feet exactly at their rest positions (footprints are continuous points), resting on the
-    highest point of the world raster under the foot (its cell and the 8 around it)."""
+    """Rest feet at their rest positions (footprints are continuous points), resting on the highest
+    point of the world raster under the foot (its cell and the 8 around it). A rest foot within a
+    foot's room of another character's (neighbours spawned close, their legs interleaved) moves
+    straight away from it to just beyond that room (:func:`_spawned_feet_apart`)."""
     r = model.raster
     fx, fz = _rot_xz(headings[:, None], model.rest_body[None, :, 0], model.rest_body[None, :, 1])
     fx = fx + positions[:, None, 0]
     fz = fz + positions[:, None, 1]
+    fx, fz = _spawned_feet_apart(fx, fz, _foot_room(model))
     rows, cols = r.frame.world_to_cell(fx, fz)
     rows = np.clip(rows, 1, r.frame.n_rows - 2)
     cols = np.clip(cols, 1, r.frame.n_cols - 2)
@@ -1397,6 +1400,34 @@ def _initial_feet(model: CrowdModel, positions, headings):
         for dc in (-1, 0, 1):
             top = np.maximum(top, r.static_top[rows + dr, cols + dc])
     return np.stack([fx, top, fz], axis=-1)
+
+
+def _spawned_feet_apart(fx, fz, room: float, rounds: int = 4):
+    """(fx, fz) (C, L) with every foot at least ``room`` (m) from the feet of the other characters:
+    of two feet closer than that, the later character's moves straight away from the other's, a few
+    rounds for chains. (Feet that started on one spot stood there until they stepped: 17 shared foot
+    spots among 64 spiders spawned on `mixed`.)"""
+    from scipy.spatial import cKDTree
+
+    n_chars, n_legs = fx.shape
+    owner = np.repeat(np.arange(n_chars), n_legs)
+    x, z = fx.ravel().copy(), fz.ravel().copy()
+    for _ in range(rounds):
+        pairs = cKDTree(np.column_stack([x, z])).query_pairs(room, output_type="ndarray")
+        if pairs.size == 0:
+            break
+        pairs = pairs[owner[pairs[:, 0]] != owner[pairs[:, 1]]]
+        if pairs.size == 0:
+            break
+        for a, b in pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))]:  # deterministic order
+            a, b = (a, b) if owner[a] < owner[b] else (b, a)  # b, of the later character, moves
+            dx, dz = x[b] - x[a], z[b] - z[a]
+            d = math.hypot(dx, dz)
+            if d >= room:
+                continue
+            ux, uz = (dx / d, dz / d) if d > 1e-12 else (1.0, 0.0)
+            x[b], z[b] = x[a] + ux * room * (1.0 + 1e-6), z[a] + uz * room * (1.0 + 1e-6)
+    return x.reshape(fx.shape), z.reshape(fz.shape)
 
 
 # ----------------------------------------------------------------------------- the frame

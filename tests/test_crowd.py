@@ -326,6 +326,24 @@ def test_other_characters_feet_and_landing_spots_are_forbidden_in_a_characters_m
     assert not forbidden_at(state.feet[0], True).any()
 
 
+def test_a_crowd_spawns_with_every_foot_a_foots_room_from_the_other_characters_feet():
+    """64 spiders spawned on ``mixed``: neighbours' legs interleave, and rest feet of two characters
+    used to start on one spot (17 shared foot spots over the first frames, until they stepped). A rest
+    foot within a foot's room of another character's moves straight away from it."""
+    from planner._crowd import _foot_room
+
+    scenario, creature = load_scenario("mixed"), load_creature("spider")
+    model, state = init_crowd(scenario, creature, load_gait(default_gait_name("spider"), creature),
+                              n_characters=64, seed=5, lod_mode="off", raster=_raster(scenario, creature))
+    feet = state.feet[..., [0, 2]].reshape(-1, 2)
+    owner = np.repeat(np.arange(64), creature.n_legs)
+    d = np.hypot(feet[:, None, 0] - feet[None, :, 0], feet[:, None, 1] - feet[None, :, 1])
+    other = owner[:, None] != owner[None, :]
+    assert d[other].min() >= _foot_room(model) - 1e-9
+    # ... and every leg still reaches its moved rest foot.
+    assert simulate(model, state, 1).max_stance_slip_m <= 1e-3
+
+
 def test_a_crowds_feet_keep_a_foots_room_from_each_other():
     """8 spiders on ``crates``: no two stance feet of different characters closer than a foot length
     (``shared_foot_spots``), because every planned foot keeps a foot's room from the other characters'
