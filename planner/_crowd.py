@@ -683,10 +683,11 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, fre
     # ahead of a body slowed on a hill, made robot5's front legs step twice a cycle (strides 40-60 %
     # off the law). A body turning on the spot does not walk toward them, nor does one near a moving
     # box: it turns away from the box, off the heading the foot is ahead along.
-    walking = (state.speed >= 0.5 * np.minimum(state.desired_speed, state.speed_limit)) & ~moving_box_near(model, state)
-    ahead = walking[:, None] & (((state.feet[..., 0] - hips[..., 0]) * np.cos(state.heading)[:, None]
-                                 + (state.feet[..., 2] - hips[..., 2]) * np.sin(state.heading)[:, None]) > 0.0)
-    far = (np.hypot(state.feet[..., 0] - hips[..., 0], state.feet[..., 2] - hips[..., 2]) > _reach_xz(model)[None, :]) & ~ahead
+    walking = state.speed >= 0.5 * np.minimum(state.desired_speed, state.speed_limit)
+    walking &= ~moving_box_near(model, state)
+    dx, dz = state.feet[..., 0] - hips[..., 0], state.feet[..., 2] - hips[..., 2]
+    ahead = walking[:, None] & (dx * np.cos(state.heading)[:, None] + dz * np.sin(state.heading)[:, None] > 0.0)
+    far = (np.hypot(dx, dz) > _reach_xz(model)[None, :]) & ~ahead
     cannot_follow = _stance_unreachable_ahead(model, state, hips, frequency)
     # A stance foot at the rear end of its window steps now: the body cannot move on without it
     # (stance_speed_cap holds the body back), and its sector may be a cycle away.
@@ -1353,8 +1354,6 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
 
 def _same_boxes(a, b) -> bool:
     """Whether two obstacle sets hold the same boxes, moving the same way (every array equal)."""
-    import dataclasses
-
     if a is b:
         return True
     for field in dataclasses.fields(a):
