@@ -55,6 +55,7 @@ from planner import EXHAUSTIVE, FootQuery, GridFrame, LocalMaps, PlannerConfig, 
 SCORE_TOL = 1e-9  # a score or goodness, dimensionless
 METRIC_TOL = 1e-9  # a raw metric (m, rad, or the scale-free energies, relative)
 PATH_TIE_TOL = 1e-12  # m: two wavefront costs this close are the same cost (a tie between paths)
+POINT_TOL = 1e-12  # m: a footprint moved out of another foot's room, computed in another order of operations
 SQRT2 = math.sqrt(2.0)
 
 # Documented constants of the path construction (planner/_kernels_foot.py's module constants and
@@ -625,7 +626,7 @@ def geometric_jerk(poly):
 
 N = 14  # cells per side: with the default radius (4 cells) and margin (6 cells) the search's region of
 CELL = 0.07  # interest is the whole map when the preferred footprint's cell is in rows/cols 3..10.
-FIXED_SEEDS = tuple(range(40))
+FIXED_SEEDS = tuple(range(40)) + (1580367954,)  # every seed that ever failed joins (1580367954: a pushed point 1 ulp apart)
 N_FRESH = 10
 
 
@@ -797,7 +798,7 @@ def test_exhaustive_search_picks_the_oracles_best_couple(seed):
         + "; ".join(_describe(c) for c in winners))
     v = matching[0]
     # Same point (the continuous footprint), same slice level, same breakdown and raw metrics.
-    assert (result.target[0], result.target[2]) == cand["point"], where
+    assert (result.target[0], result.target[2]) == pytest.approx(cand["point"], rel=0, abs=POINT_TOL), where
     assert result.target[1] == oracle.elev_dil[cand["cell"]], where
     assert result.slice_level_m == oracle.levels[s], where
     assert abs(result.footprint_score - cand["score"]) <= SCORE_TOL, where
@@ -820,7 +821,8 @@ def test_every_couple_scores_as_the_oracle_says(seed):
                                      f"only the oracle {sorted(set(mine) - set(theirs))}"
     for cell, k in theirs.items():
         cand = mine[cell]
-        assert (h.cand_xyz[k, 0], h.cand_xyz[k, 2]) == cand["point"], f"{where}: point of {cell}"
+        assert (h.cand_xyz[k, 0], h.cand_xyz[k, 2]) == pytest.approx(cand["point"], rel=0, abs=POINT_TOL), \
+            f"{where}: point of {cell}"
         np.testing.assert_allclose(h.cand_features[k], cand["features"], rtol=METRIC_TOL, atol=METRIC_TOL,
                                    err_msg=f"{where}: features of {cell}")
         np.testing.assert_allclose(h.cand_terms[k], cand["terms"], rtol=0, atol=SCORE_TOL, err_msg=f"{where}: {cell}")

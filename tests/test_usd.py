@@ -213,6 +213,7 @@ def test_cli_exports_a_recording(run, tmp_path):
     assert len([p for p in stage.Traverse() if p.IsA(UsdSkel.Skeleton)]) == CHARACTERS
 
 
+@pytest.mark.slow  # two CLI runs (about 6 s)
 def test_a_recording_of_a_users_creature_exports_without_its_file(tmp_path):
     # The recording carries the creature file's text: the file may be gone (or never shipped along).
     import shutil
