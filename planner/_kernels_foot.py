@@ -228,12 +228,7 @@ def weighted_mean(w, terms, lo, hi):
 @nb.njit(cache=True)
 def _clear_of_other_feet(x, z, other_legs, leg_gap, feet_block_radius):
     """A footprint at (x, z) keeps ``feet_block_radius`` from every other leg (hip -> foot) and foot."""
-    if leg_gap < feet_block_radius:
-        return False
-    for j in range(other_legs.shape[0]):
-        if math.hypot(x - other_legs[j, 2], z - other_legs[j, 3]) <= feet_block_radius:
-            return False
-    return True
+    return leg_gap >= feet_block_radius and not _near_other_foot(x, z, other_legs, feet_block_radius)
 
 
 @nb.njit(cache=True)

@@ -186,9 +186,6 @@ def _target(file: str, where: str, quantity: str, entry, sources: dict[str, str]
 
 def load_targets(path: str | Path = TARGETS_FILE, creatures=None) -> dict[str, CreatureTargets]:
     """Targets per creature (default: every built-in creature), with every quantity."""
-    from planner._timing import hip_height
-    from scenarios import builtin_creature_names, load_creature
-
     file = str(path)
     try:
         data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
@@ -198,6 +195,14 @@ def load_targets(path: str | Path = TARGETS_FILE, creatures=None) -> dict[str, C
         raise InputError(file, "targets", "not UTF-8 text") from None
     except tomllib.TOMLDecodeError as error:
         raise InputError(file, "targets", f"invalid TOML: {str(error).splitlines()[0]}") from None
+    return _whole_targets(data, file, creatures)
+
+
+def _whole_targets(data: dict, file: str, creatures) -> dict[str, CreatureTargets]:
+    """:func:`load_targets` of a whole targets file's parsed ``data`` (``file`` names it in errors)."""
+    from planner._timing import hip_height
+    from scenarios import builtin_creature_names, load_creature
+
     for key in data:
         if key not in ("schema_version", "sources", "defaults", "creatures"):
             raise InputError(file, key, "unknown field; expected schema_version, sources, defaults, creatures")
@@ -272,8 +277,8 @@ def load_tune_targets(path: str | Path | None, creature: str) -> CreatureTargets
         return load_targets(creatures=(creature,))[name]
     file = str(path)
     data = _read(path)
-    if "defaults" in data:
-        return dataclasses.replace(load_targets(path, creatures=(creature,))[name], file=file)
+    if "defaults" in data:  # a whole targets file, already read
+        return dataclasses.replace(_whole_targets(data, file, (creature,))[name], file=file)
     allowed = ("schema_version", "sources", "style", *QUANTITIES)
     for key in data:
         if key not in allowed:
