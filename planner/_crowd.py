@@ -543,9 +543,11 @@ def travel(speed, goal, acceleration: float, duration):
     return speed * ramp + 0.5 * sign * acceleration * ramp**2 + goal * (duration - ramp)
 
 
-def _reach_xz(model: CrowdModel) -> np.ndarray:
-    reach = model.controller.reach_margin * model.reach
-    dy = model.creature.standing_height + model.hips_body[:, 1]
+def _reach_xz(model: CrowdModel, legs=slice(None), drop=None) -> np.ndarray:
+    """m, how far from its hip (horizontally) each leg reaches a foot ``drop`` below the hip (default:
+    the ground on flat, the standing height below the pelvis), within the controller's reach margin."""
+    reach = model.controller.reach_margin * model.reach[legs]
+    dy = model.creature.standing_height + model.hips_body[legs, 1] if drop is None else drop
     return np.sqrt(np.maximum(reach**2 - dy**2, (0.2 * reach) ** 2))
 
 
@@ -918,7 +920,12 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     drop = model.creature.standing_height + model.hips_body[ls, 1]
     # Kept within [0.5, 1.25]: for a leg nearly under its hip the distance is all drop, and keeping it
     # would pull a downhill foot under the hip and throw an uphill one far out (legs cross).
-    scale = np.clip(slope_scale(offset, drop, np.tan(state.pitch[cs]), np.tan(state.roll[cs])), 0.5, 1.25)
+    slope_forward, slope_left = np.tan(state.pitch[cs]), np.tan(state.roll[cs])
+    scale = np.clip(slope_scale(offset, drop, slope_forward, slope_left), 0.5, 1.25)
+    # The reach is measured where the foot lands: on the uphill side the ground is nearer the hip
+    # and the leg reaches further out. The flat reach refused the uphill foot's own cell (slope_scale
+    # throws it out to keep the leg's length), and that foot landed a cell short, then a cell long.
+    ground_drop = drop - scale * (slope_forward * offset[:, 0] + slope_left * offset[:, 1])
     ox, oz = _rot_xz(heading, scale * offset[:, 0], scale * offset[:, 1])
     preferred = hip_pred + np.stack([ox, oz], axis=1) + fwd * (0.5 * sweep)[:, None]
     foot_yaw = np.arctan2(preferred[:, 1] - hip_pred[:, 1], preferred[:, 0] - hip_pred[:, 0])
@@ -942,7 +949,7 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
         foot_shape=np.stack([np.full(f, model.creature.foot_length), np.full(f, model.creature.foot_width), foot_yaw],
                             axis=1),
         sources=np.ascontiguousarray(state.feet[cs, ls]), preferred=np.ascontiguousarray(preferred),
-        hips=np.ascontiguousarray(hip_pred), reach_xz=_reach_xz(model)[ls],
+        hips=np.ascontiguousarray(hip_pred), reach_xz=_reach_xz(model, ls, ground_drop),
         step_height=np.full(f, model.step_height),
         legs=legs, legs_start=legs_start,
         block_radius=np.full(f, _foot_room(model)),
