@@ -57,3 +57,43 @@ def fresh_seeds(fixed, n_fresh, *, salt=0):
 
     rng = np.random.default_rng([_SESSION_SEED, salt])
     return list(fixed) + [int(s) for s in rng.integers(1000, 2**31 - 1, n_fresh)]
+
+
+# --------------------------------------------------------------------------- the command line in-process
+def footfall_cli(*args, cwd=None):
+    """Run ``footfall ARGS`` in this process, as the console script does (:func:`footfall.cli.main`):
+    a ``subprocess.CompletedProcess`` with its exit code and everything it printed.
+
+    For the many bad-input cases: a Python process per case cost about a second of imports each
+    (a fifth of the suite went to starting interpreters). What a process adds is kept: an exception
+    that escapes ``main`` fails the test (a process would print its traceback), and warnings print
+    on the captured stderr, as they would in a process. A few tests still start real processes
+    (the entry point itself, import-time behaviour).
+    """
+    import contextlib
+    import io
+    import subprocess
+    import warnings
+
+    from footfall.cli import main
+
+    argv = [str(a) for a in args]
+    out, err = io.StringIO(), io.StringIO()
+    code = 0
+    here = os.getcwd()
+    try:
+        if cwd is not None:
+            os.chdir(cwd)
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err), warnings.catch_warnings():
+            warnings.simplefilter("default")
+            warnings.showwarning = (lambda message, category, filename, lineno, file=None, line=None:
+                                    err.write(warnings.formatwarning(message, category, filename, lineno, line)))
+            try:
+                main(argv)
+            except SystemExit as e:
+                if isinstance(e.code, str):  # sys.exit("message"): the interpreter prints it, exit code 1
+                    err.write(e.code + "\n")
+                code = e.code if isinstance(e.code, int) else (0 if e.code is None else 1)
+    finally:
+        os.chdir(here)
+    return subprocess.CompletedProcess(["footfall", *argv], code, out.getvalue(), err.getvalue())

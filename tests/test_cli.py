@@ -5,6 +5,7 @@ import subprocess
 import sys
 
 import pytest
+from conftest import footfall_cli  # the many bad-input cases run in-process (conftest says why)
 
 CLI = [sys.executable, "-m", "footfall.cli"]
 
@@ -26,7 +27,7 @@ def test_malformed_scenario_is_one_line_and_exit_2(tmp_path, content, field):
     path = tmp_path / "bad.toml"
     path.write_text(content)
     for command in (["check", str(path)], ["plan", str(path)]):
-        proc = run(*command)
+        proc = footfall_cli(*command)
         assert proc.returncode == 2, proc.stderr
         lines = proc.stderr.strip().splitlines()
         assert len(lines) == 1, proc.stderr
@@ -36,6 +37,7 @@ def test_malformed_scenario_is_one_line_and_exit_2(tmp_path, content, field):
 
 
 def test_unknown_scenario_and_bad_budget():
+    # Real processes: the entry point itself turns bad input into one line and exit code 2.
     proc = run("plan", "no-such-place")
     assert proc.returncode == 2 and "no-such-place" in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
     proc = run("plan", "flat", "--budget", "lavish")
@@ -106,7 +108,7 @@ BAD_INPUTS = [
 def test_every_bad_input_is_one_line_and_exit_2(tmp_path, args, expected):
     terain = tmp_path / "terain.toml"
     terain.write_text(TERAIN)
-    proc = run(*[a.replace("{terain}", str(terain)) for a in args], cwd=tmp_path)
+    proc = footfall_cli(*[a.replace("{terain}", str(terain)) for a in args], cwd=tmp_path)
     assert proc.returncode == 2, proc.stderr
     assert proc.stdout == ""
     lines = proc.stderr.splitlines()

@@ -7,6 +7,7 @@ import sys
 
 import numpy as np
 import pytest
+from conftest import footfall_cli
 
 from planner import PlannerConfig, WorldRaster
 from planner._crowd import hips_world, init_crowd, planner_config_for
@@ -138,17 +139,17 @@ def test_impossible_inputs_fail_before_the_simulation(tmp_path):
     legless = tmp_path / "legless.toml"
     legless.write_text("name = 'blob'\nstanding_height = 0.1\nbody_thickness = 0.05\nbody_box = [0.2, 0.1]\n"
                        "foot = { length = 0.02, width = 0.02 }\n")
-    _one_line_exit_2(_cli("simulate", "flat", "--creature", str(legless), "--frames", "2"), str(legless))
+    _one_line_exit_2(footfall_cli("simulate", "flat", "--creature", str(legless), "--frames", "2"), str(legless))
     # A gait with every foot swinging at once.
     gait = tmp_path / "float.toml"
     rows = "\n".join(f"{leg} = {{ start = 0.0, duration = 0.9 }}" for leg in ("LF", "RF", "LH", "RH"))
     gait.write_text(f"[swing]\n{rows}\n")
-    _one_line_exit_2(_cli("simulate", "flat", "--creature", "quadruped", "--gait", str(gait), "--frames", "2"),
+    _one_line_exit_2(footfall_cli("simulate", "flat", "--creature", "quadruped", "--gait", str(gait), "--frames", "2"),
                      str(gait))
     # A speed beyond the legs' reach is not refused: the controller caps it and says so (issue 13).
     fast = tmp_path / "fast.toml"
     fast.write_text(_scenario_text(terrain='kind = "flat"\nsize = [20.0, 20.0]\ncell_size = 0.05', speed=25.0))
-    proc = _cli("simulate", str(fast), "--frames", "60", "--json")
+    proc = footfall_cli("simulate", str(fast), "--frames", "60", "--json")
     assert proc.returncode == 0, proc.stderr
     summary = json.loads(proc.stdout)
     assert summary["speed_asked"] == 25.0 and 0.1 < summary["speed_cap"] < 25.0, summary
@@ -162,7 +163,7 @@ def test_impossible_inputs_fail_before_the_simulation(tmp_path):
     nan_scn = tmp_path / "nan.toml"
     nan_scn.write_text(_scenario_text(terrain=f'kind = "heightmap"\nfile = "{nan_map.name}"\ncell_size = 0.1\n'
                                               f'height_scale = 1.0', speed=0.3))
-    _one_line_exit_2(_cli("simulate", str(nan_scn), "--frames", "2"), str(nan_scn))
+    _one_line_exit_2(footfall_cli("simulate", str(nan_scn), "--frames", "2"), str(nan_scn))
 
 
 def test_creature_too_large_for_its_map_is_refused():

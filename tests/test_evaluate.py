@@ -101,10 +101,9 @@ def test_strict_fails_on_a_violation_and_a_plain_run_reports_it(monkeypatch, tmp
     (["flat", "--workers", "2", "--cluster", "tcp://h:8786"], "--workers"),
 ])
 def test_bad_input_is_one_line_and_exit_2(args, field):
-    import subprocess
-    import sys
+    from conftest import footfall_cli
 
-    proc = subprocess.run([sys.executable, "-m", "footfall.cli", "evaluate", *args], capture_output=True, text=True)
+    proc = footfall_cli("evaluate", *args)
     assert proc.returncode == 2, proc.stderr
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("footfall: error:") and field in lines[0], proc.stderr

@@ -5,6 +5,7 @@ import subprocess
 import sys
 
 import pytest
+from conftest import footfall_cli
 
 from footfall import InputError
 from planner import GaitTiming, ScoringWeights, load_preset, preset_dict
@@ -45,16 +46,14 @@ def test_bad_presets_are_refused_naming_the_field(tmp_path, mutate, field):
 
 def test_cli_refuses_a_preset_for_another_creature(tmp_path):
     path = _write(tmp_path, preset_dict("ant", ScoringWeights()))
-    proc = subprocess.run([sys.executable, "-m", "footfall.cli", "simulate", "flat", "--frames", "2", "--preset",
-                           str(path)], capture_output=True, text=True, timeout=600)
+    proc = footfall_cli("simulate", "flat", "--frames", "2", "--preset", path)
     assert proc.returncode == 2 and str(path) in proc.stderr and "creature" in proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1
 
 
 def test_cli_takes_a_shipped_preset_by_name_and_refuses_an_unknown_name():
     def simulate(preset):
-        return subprocess.run([sys.executable, "-m", "footfall.cli", "simulate", "flat", "--frames", "3", "--preset",
-                               preset, "--json"], capture_output=True, text=True, timeout=600)
+        return footfall_cli("simulate", "flat", "--frames", "3", "--preset", preset, "--json")
 
     proc = simulate("spider")
     assert proc.returncode == 0, proc.stderr

@@ -10,6 +10,7 @@ import sys
 
 import numpy as np
 import pytest
+from conftest import footfall_cli
 
 pytestmark = pytest.mark.slow  # pyvista renders in subprocesses (about 25 s)
 
@@ -137,7 +138,7 @@ def test_render_writes_a_gif(recording, tmp_path):
 def test_bad_input_is_one_line_and_exit_2(recording, tmp_path, args, field):
     args = [str(recording) if a == "RECORDING" else str(tmp_path / a) if a.endswith((".avi", ".mp4", ".npz"))
             else a for a in args]
-    proc = footfall("render", *args)
+    proc = footfall_cli("render", *args)  # refused before any rendering: in-process
     assert proc.returncode == 2, (proc.stdout, proc.stderr)
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("footfall: error: ") and field in lines[0], proc.stderr

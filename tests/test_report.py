@@ -11,6 +11,7 @@ import sys
 
 import numpy as np
 import pytest
+from conftest import footfall_cli
 
 CLI = [sys.executable, "-m", "footfall.cli"]
 HEADLESS = dict(os.environ, VTK_DEFAULT_OPENGL_WINDOW="vtkEGLRenderWindow")
@@ -347,14 +348,14 @@ def _one_line_error(proc, *needles):
 
 def test_unknown_scenario_is_one_line_and_nothing_is_written(tmp_path):
     out = tmp_path / "report"
-    _one_line_error(run("report", "--quick", "no-such-place", "--out", str(out)), "no-such-place")
+    _one_line_error(footfall_cli("report", "--quick", "no-such-place", "--out", str(out)), "no-such-place")
     assert list(tmp_path.iterdir()) == []
 
 
 def test_unwritable_out_is_one_line_and_nothing_is_left(tmp_path):
     blocker = tmp_path / "a-file"
     blocker.write_text("not a folder")
-    _one_line_error(run("report", "--quick", "--out", str(blocker / "report")), "--out")
+    _one_line_error(footfall_cli("report", "--quick", "--out", str(blocker / "report")), "--out")
     assert list(tmp_path.iterdir()) == [blocker] and blocker.read_text() == "not a folder"
 
 
@@ -362,7 +363,7 @@ def test_a_folder_that_is_not_a_report_is_not_replaced(tmp_path):
     out = tmp_path / "mine"
     out.mkdir()
     (out / "notes.txt").write_text("keep me")
-    _one_line_error(run("report", "--quick", "--out", str(out)), "--out", "not a footfall report")
+    _one_line_error(footfall_cli("report", "--quick", "--out", str(out)), "--out", "not a footfall report")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["mine"] and (out / "notes.txt").read_text() == "keep me"
 
 
@@ -372,7 +373,7 @@ def test_recording_from_another_version_is_refused(tmp_path):
     np.savez(recording, header=np.array(json.dumps(header)), feet=np.zeros((2, 1, 8, 3)),
              pelvis=np.zeros((2, 1, 3)), in_stance=np.ones((2, 1, 8), bool))
     out = tmp_path / "report"
-    _one_line_error(run("report", "--quick", "--recording", str(recording), "--out", str(out)), str(recording),
+    _one_line_error(footfall_cli("report", "--quick", "--recording", str(recording), "--out", str(out)), str(recording),
                     "version 99")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["old.npz"]
 

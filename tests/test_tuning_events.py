@@ -3,12 +3,11 @@ terrain / style tune, and the preset x terrain matrix's rules."""
 
 import json
 import math
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import footfall_cli
 
 from footfall import InputError
 
@@ -97,8 +96,7 @@ def test_cli_refuses_a_malformed_targets_file_with_one_line_and_exit_2(tmp_path)
     for args, field in (([f"--targets={bad}"], "style.max_touchdown_slope_rad"),
                         ([f"--targets={tmp_path / 'none.toml'}"], "targets"),
                         (["--scenarios=stairs,nowhere"], "scenario")):
-        proc = subprocess.run([sys.executable, "-m", "footfall.cli", "tune", "--creature", "spider", *args,
-                               "--out", str(tmp_path / "p.json")], capture_output=True, text=True, cwd=ROOT)
+        proc = footfall_cli("tune", "--creature", "spider", *args, "--out", tmp_path / "p.json", cwd=ROOT)
         assert proc.returncode == 2, proc.stderr
         assert field in proc.stderr and len(proc.stderr.strip().splitlines()) == 1, proc.stderr
         assert not (tmp_path / "p.json").exists()

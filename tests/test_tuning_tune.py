@@ -3,11 +3,10 @@ a killed run resumed gives the same bytes (on local workers and in-process), shi
 for their creature only, and what the shipped presets do on held-out runs."""
 
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
+from conftest import footfall_cli
 
 from footfall import InputError
 from planner import load_preset
@@ -119,8 +118,7 @@ def test_cli_refuses_bad_input_with_one_line():
                         (["--creature", "spider", "--start-timing", "stride_coefficient=x"], "--start-timing"),
                         (["--creature", "spider", "--start-timing", "stride_coeficient=3"], "stride_coeficient"),
                         (["--creature", "spider", "--start-timing", "stride_exponent=0.7"], "stride_exponent")):
-        proc = subprocess.run([sys.executable, "-m", "footfall.cli", "tune", *args], capture_output=True, text=True,
-                              timeout=300)
+        proc = footfall_cli("tune", *args)
         assert proc.returncode == 2, proc.stderr
         assert field in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
 

@@ -6,6 +6,7 @@ import sys
 
 import numpy as np
 import pytest
+from conftest import footfall_cli
 from pxr import Gf, Usd, UsdGeom, UsdSkel, UsdValidation
 
 from footfall._errors import InputError
@@ -242,7 +243,7 @@ def test_a_recording_of_a_users_creature_exports_without_its_file(tmp_path):
 
 
 def test_cli_unknown_scenario(tmp_path):
-    line = _one_line_exit_2(_cli("export-usd", "no-such-place", "--out", str(tmp_path / "x.usda")))
+    line = _one_line_exit_2(footfall_cli("export-usd", "no-such-place", "--out", str(tmp_path / "x.usda")))
     assert "no-such-place" in line
     assert list(tmp_path.iterdir()) == []
 
@@ -250,7 +251,7 @@ def test_cli_unknown_scenario(tmp_path):
 def test_cli_unwritable_output_leaves_nothing(run, tmp_path):
     blocker = tmp_path / "a-file"
     blocker.write_text("not a folder")
-    line = _one_line_exit_2(_cli("export-usd", "--recording", str(run["path"]), "--out",
+    line = _one_line_exit_2(footfall_cli("export-usd", "--recording", str(run["path"]), "--out",
                                  str(blocker / "scene.usda")))
     assert "a-file" in line
     assert [p.name for p in tmp_path.iterdir()] == ["a-file"] and blocker.read_text() == "not a folder"
@@ -265,7 +266,7 @@ def test_cli_recording_from_another_version(run, tmp_path):
     np.savez_compressed(old, header=np.array(json.dumps(header)), **arrays)
     out = tmp_path / "scene.usdc"
     out.write_text("previous export")
-    line = _one_line_exit_2(_cli("export-usd", "--recording", str(old), "--out", str(out)))
+    line = _one_line_exit_2(footfall_cli("export-usd", "--recording", str(old), "--out", str(out)))
     assert "header.version" in line
     assert out.read_text() == "previous export"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["other.npz", "scene.usdc"]
