@@ -28,12 +28,10 @@ def _raster(scenario, creature):
     return _rasters[scenario.name, cell]
 
 
-# Found by the counters on the rendered pose (planner._counters), not fixed yet (issue 13/20, open):
-# a quadruped's knees cross once in a while on hills. (The spider's stance slip on hills is fixed:
-# a body pose its stance legs cannot follow is taken back.) Strict: when they are fixed, these runs must pass.
-KNOWN_DEFECTS = {
-    ("quadruped", "hills"): "rendered leg crossings on hills (the knees fold across)",
-}
+# Found by the counters on the rendered pose (planner._counters) and not fixed yet; strict: when one
+# is fixed, its runs must pass. (A quadruped's knees crossed on hills, folded under the body by a leg
+# plane turned inward: fixed in the IK, planner._kernels_ik._knee_inward.)
+KNOWN_DEFECTS: dict[tuple[str, str], str] = {}
 
 
 @pytest.mark.parametrize("scenario_name", builtin_scenario_names())

@@ -287,6 +287,30 @@ def test_warm_start_from_the_solution_needs_no_further_sweep():
     assert np.percentile(hinge_moves, 99) < 0.5  # measured 0.41: no knee flips to a mirror pose
 
 
+def test_an_upright_leg_keeps_its_knee_on_its_own_side():
+    # The quadruped's left front leg: its rest foot beside its hip (free azimuth). Of the two leg planes
+    # through a target ahead and outside the hip, the one turned under the body (reached from a warm
+    # start on that side) folds the knee across the other legs; restarts find the outward one.
+    creature = load_creature("quadruped")
+    legs = legs_of(creature)
+    leg = creature.leg_names.index("LF")
+    alpha = legs.rest_azimuths[leg]
+    assert legs.azimuth_limits[leg] == math.pi and math.sin(alpha) > 0.5  # premise: upright, on the left
+    hip = legs.hips[leg]
+    target = hip + np.array([0.10, -0.40, 0.03])
+    inward = math.atan2(0.03, 0.10) + math.pi - alpha  # the plane pointing away from the target
+    warm = np.array([[math.remainder(inward, 2 * math.pi), 1.4, 1.0, 0.5]])
+    args = (hip[None], np.eye(3)[None], legs.rest_azimuths[leg:leg + 1], legs.segment_lengths[leg:leg + 1],
+            legs.limits[leg:leg + 1], legs.azimuth_limits[leg:leg + 1], target[None])
+    kept = solve_legs(*args, warm_start=warm, restarts=0)  # no restart: the warm start's branch
+    assert kept.converged[0] and math.sin(alpha + kept.angles[0, 0]) < 0.0  # premise: converged, knee inward
+    turned = solve_legs(*args, warm_start=warm)
+    assert turned.converged[0]
+    assert math.sin(alpha + turned.angles[0, 0]) > 0.0  # the leg plane points out to the left
+    knee = turned.joints[0, 2] - hip
+    assert knee[2] > 0.0, knee  # and so does the knee
+
+
 def test_serial_and_parallel_kernels_are_bit_identical():
     creature = load_creature("spider")
     legs = legs_of(creature)
