@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from planner._ik import DEFAULT_TOLERANCE
 from planner._kernels_controller import (
     count_body_overlaps,
     count_close_pairs,
@@ -36,6 +37,10 @@ from planner._kernels_controller import (
     count_polyline_crossings,
 )
 
+CONTACT_TOLERANCE_M = DEFAULT_TOLERANCE
+"""m: a rendered foot this close below a box's top stands on it. The IK places a foot within its
+tolerance of the planned one, and a planned foot on a box stands exactly on its top: rendered 6-18 um
+lower, feet standing on crates counted as collisions."""
 STUCK_WINDOW_S = 2.0
 """Window over which a character's progress is measured for ``stuck_seconds``."""
 STUCK_FRACTION = 0.1
@@ -105,7 +110,7 @@ class FrameCounters:
                                  state.foot_yaws, np.ascontiguousarray(centres[mask]),
                                  np.ascontiguousarray(obs.sizes[mask], dtype=np.float64),
                                  np.ascontiguousarray(yaws[mask]),
-                                 np.ascontiguousarray(np.asarray(obs.forbidden)[mask], dtype=np.bool_), self._per_char)
+                                 np.ascontiguousarray(np.asarray(obs.forbidden)[mask], dtype=np.bool_), self._per_char, CONTACT_TOLERANCE_M)
                 setattr(self, name, getattr(self, name) + int(self._per_char.sum()))
         count_polyline_crossings(np.ascontiguousarray(rendered_joints(model, state)), self._per_char)
         self.leg_crossings += int(self._per_char.sum())

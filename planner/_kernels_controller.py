@@ -104,15 +104,18 @@ def stance_threatened(in_stance, feet, foot_hx, foot_hz, foot_yaws, margin, box_
 
 
 @nb.njit(cache=True, parallel=True)
-def count_collisions(feet, foot_hx, foot_hz, foot_yaws, box_centres, box_sizes, box_yaws, box_forbidden, out):
-    """Per character, feet overlapping a box below its top (forbidden: at any height)."""
+def count_collisions(feet, foot_hx, foot_hz, foot_yaws, box_centres, box_sizes, box_yaws, box_forbidden, out,
+                     top_tolerance=0.0):
+    """Per character, feet overlapping a box below its top (forbidden: at any height). A foot within
+    ``top_tolerance`` below a box's top stands on it (a rendered foot is within the IK's tolerance of
+    the planned one, which stands exactly on the top)."""
     n_chars, n_legs, _ = feet.shape
     everything = np.ones(box_centres.shape[0], dtype=np.bool_)
     for c in nb.prange(n_chars):
         n = 0
         for i in range(n_legs):
-            if foot_box_conflict(feet[c, i, 0], feet[c, i, 1], feet[c, i, 2], foot_hx, foot_hz, foot_yaws[c, i],
-                                 0.0, box_centres, box_sizes, box_yaws, box_forbidden, everything):
+            if foot_box_conflict(feet[c, i, 0], feet[c, i, 1] + top_tolerance, feet[c, i, 2], foot_hx, foot_hz,
+                                 foot_yaws[c, i], 0.0, box_centres, box_sizes, box_yaws, box_forbidden, everything):
                 n += 1
         out[c] = n
 

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from planner._counters import CONTACT_TOLERANCE_M
 from planner._kernels_controller import count_body_overlaps, count_collisions
 from planner._lod import LEVEL_NAMES
 
@@ -100,7 +101,8 @@ class LevelMeter:
         count_collisions(np.ascontiguousarray(rendered), 0.5 * model.creature.foot_length,
                          0.5 * model.creature.foot_width, state.foot_yaws, np.ascontiguousarray(centres),
                          np.ascontiguousarray(obs.sizes, dtype=np.float64), np.ascontiguousarray(yaws),
-                         np.ascontiguousarray(obs.forbidden, dtype=np.bool_), self._per_char)
+                         np.ascontiguousarray(obs.forbidden, dtype=np.bool_), self._per_char,
+                         CONTACT_TOLERANCE_M)
 
     def _count_overlaps(self, state) -> None:
         self._per_char[:] = 0
