@@ -110,7 +110,8 @@ class FrameCounters:
                                  state.foot_yaws, np.ascontiguousarray(centres[mask]),
                                  np.ascontiguousarray(obs.sizes[mask], dtype=np.float64),
                                  np.ascontiguousarray(yaws[mask]),
-                                 np.ascontiguousarray(np.asarray(obs.forbidden)[mask], dtype=np.bool_), self._per_char, CONTACT_TOLERANCE_M)
+                                 np.ascontiguousarray(np.asarray(obs.forbidden)[mask], dtype=np.bool_), self._per_char,
+                                 CONTACT_TOLERANCE_M)
                 setattr(self, name, getattr(self, name) + int(self._per_char.sum()))
         count_polyline_crossings(np.ascontiguousarray(rendered_joints(model, state)), self._per_char)
         self.leg_crossings += int(self._per_char.sum())
