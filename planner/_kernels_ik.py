@@ -106,7 +106,9 @@ closest reachable pose found, with the distance reported as the residual
 (never NaN, never an exception). An upright leg (free azimuth, its rest foot beside its hip)
 whose reaching pose turns its leg plane under the body (:func:`_knee_inward`: the knee folds
 across the other legs) goes on restarting while restarts remain, and a pose that reaches the
-foot with the plane on the leg's own side replaces it; once a pose reaches the foot, nothing
+foot with the plane on the leg's own side replaces it (every frame while the knee stays under the
+body: 100 quadrupeds' IK costs 1.2 ms a frame instead of 0.56; searching only when a pose first turns
+inward cost 0.8 ms but left 4 times the crossings on hills); once a pose reaches the foot, nothing
 else replaces it (not a pose closer by round-off: the same legs posed in a rotated frame get the
 same angles). Restarts trade continuity for reach: a warm
 start whose target left its reachable branch (e.g. past the azimuth limit) may

@@ -298,11 +298,12 @@ def test_an_upright_leg_keeps_its_knee_on_its_own_side():
     assert legs.azimuth_limits[leg] == math.pi and math.sin(alpha) > 0.5  # premise: upright, on the left
     hip = legs.hips[leg]
     target = hip + np.array([0.10, -0.40, 0.03])
-    inward = math.atan2(0.03, 0.10) + math.pi - alpha  # the plane pointing away from the target
-    warm = np.array([[math.remainder(inward, 2 * math.pi), 1.4, 1.0, 0.5]])
+    # Warm start: the leg plane at rest (outward), the leg folded back behind the hip: the first descent
+    # turns the plane to the side of the folded foot, away from the target, under the body.
+    warm = np.array([[0.0, 1.5, 1.6, 1.6]])
     args = (hip[None], np.eye(3)[None], legs.rest_azimuths[leg:leg + 1], legs.segment_lengths[leg:leg + 1],
             legs.limits[leg:leg + 1], legs.azimuth_limits[leg:leg + 1], target[None])
-    kept = solve_legs(*args, warm_start=warm, restarts=0)  # no restart: the warm start's branch
+    kept = solve_legs(*args, warm_start=warm, restarts=0)  # no restart: the first descent's pose
     assert kept.converged[0] and math.sin(alpha + kept.angles[0, 0]) < 0.0  # premise: converged, knee inward
     turned = solve_legs(*args, warm_start=warm)
     assert turned.converged[0]
