@@ -130,21 +130,31 @@ def froude_number(v, h):
 def stride_length(timing: GaitTiming, v, h):
     """lambda = stride_coefficient * h * Fr^stride_exponent (m); 0 at v = 0. Broadcasts ``v`` and ``h``."""
     speed, height, scalar = _speed_height(v, h)
-    froude = speed * speed / (GRAVITY * height)
-    with np.errstate(divide="ignore"):
-        length = timing.stride_coefficient * height * np.power(froude, timing.stride_exponent)
-    # Fr^0 = 1 even at Fr = 0; a creature standing still has no stride.
-    return _out(np.where(speed > 0.0, length, 0.0), scalar)
+    return _out(_stride_length(timing, speed, height), scalar)
 
 
 def stride_frequency(timing: GaitTiming, v, h):
     """f = max(v / lambda, min_frequency_hz) for v > 0, 0 at v = 0 (Hz). Broadcasts ``v`` and ``h``."""
     speed, height, scalar = _speed_height(v, h)
-    length = np.asarray(stride_length(timing, speed, height), dtype=np.float64)
+    return _out(_stride_frequency(timing, speed, height), scalar)
+
+
+def _stride_length(timing: GaitTiming, speed: np.ndarray, height) -> np.ndarray:
+    """:func:`stride_length` of speeds already checked (the runtime's per-frame calls skip the checks)."""
+    froude = speed * speed / (GRAVITY * height)
+    with np.errstate(divide="ignore"):
+        length = timing.stride_coefficient * height * np.power(froude, timing.stride_exponent)
+    # Fr^0 = 1 even at Fr = 0; a creature standing still has no stride.
+    return np.where(speed > 0.0, length, 0.0)
+
+
+def _stride_frequency(timing: GaitTiming, speed: np.ndarray, height) -> np.ndarray:
+    """:func:`stride_frequency` of speeds already checked."""
+    length = _stride_length(timing, speed, height)
     moving = speed > 0.0
     with np.errstate(divide="ignore", invalid="ignore"):
         natural = np.where(moving, speed / np.where(moving, length, 1.0), 0.0)
-    return _out(np.where(moving, np.maximum(natural, timing.min_frequency_hz), 0.0), scalar)
+    return np.where(moving, np.maximum(natural, timing.min_frequency_hz), 0.0)
 
 
 def duty_factor(timing: GaitTiming, v, h):
