@@ -105,7 +105,7 @@ def stance_threatened(in_stance, feet, foot_hx, foot_hz, foot_yaws, margin, box_
 
 @nb.njit(cache=True, parallel=True)
 def count_collisions(feet, foot_hx, foot_hz, foot_yaws, box_centres, box_sizes, box_yaws, box_forbidden, out,
-                     top_tolerance=0.0):
+                     top_tolerance):
     """Per character, feet overlapping a box below its top (forbidden: at any height). A foot within
     ``top_tolerance`` below a box's top stands on it (a rendered foot is within the IK's tolerance of
     the planned one, which stands exactly on the top)."""
