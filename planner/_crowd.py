@@ -227,6 +227,7 @@ class CrowdState:
     speed_limit: np.ndarray  # (C,) m/s, the sustainable speed learnt from holds (inf: never held)
     last_move: np.ndarray  # (C, 2) m, the pelvis's move on the ground in the last steer stage
     cannot_follow: np.ndarray  # (C, L) bool: the last look-ahead found the leg cannot follow its stance foot
+    unfollowed: np.ndarray  # (C, L) bool: a stance foot whose leg lost it (the pose was taken back): it steps next
     pose_before: np.ndarray  # (C, 6) pelvis x, y, z, heading, pitch, roll at the start of the frame
     gait_index: np.ndarray  # (C,) int: the schedule's gait each character walks with (or moves toward)
     stride_frequency: np.ndarray  # (C,) Hz, the needle's rate at the last gait stage
@@ -317,6 +318,10 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
         push += veer[:, None] * np.column_stack([direction[:, 1], -direction[:, 0]])
         direction = direction + 1.5 * push
         direction /= np.maximum(np.hypot(direction[:, 0], direction[:, 1]), 1e-9)[:, None]
+    # Out of a moving box's lane: a character the box will reach within LANE_HORIZON heads out of
+    # its path, to the nearer side, before ORCA (which, for a walker that only goes forward, settles
+    # on slowing down in the lane until the box is on it).
+    direction, in_lane = _lane_exit(model, state, direction)
     # Reciprocal avoidance (ORCA) of the other characters and of forbidden or moving boxes: the
     # velocity closest to the preferred one that stays clear for the horizon.
     # Arriving: on the last leg of its route a character brakes in time (at its acceleration) to
@@ -337,6 +342,8 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
     # hips across the stance feet (legs cross): below a quarter of its goal speed, a character
     # turns more slowly, down to a quarter of the turn rate when standing.
     rate = ctl.turn_rate * dt * np.clip(4.0 * state.speed / np.maximum(goal_speed, 1e-9), 0.25, 1.0)
+    # Out of a moving box's way: turning fast is the escape (the body walks only along its heading).
+    rate = np.where(in_lane, ctl.turn_rate * dt, rate)
     state.heading = _wrap(state.heading + np.clip(turn, -rate, rate))
     forward = np.cos(np.clip(turn, -np.pi / 2, np.pi / 2))
     # Unhindered, a character keeps walking (at least 30 %) while it turns; avoiding, it walks only
@@ -385,6 +392,60 @@ KEEP_RIGHT = 0.1
 in a symmetric standstill (two characters exactly head-on), a shared convention breaks the tie."""
 
 
+LANE_HORIZON = 3.0
+"""s: a moving box that will reach a character within this time makes it leave the box's lane."""
+
+
+def _lane_exit(model: CrowdModel, state: CrowdState, direction: np.ndarray):
+    """(direction (C, 2), in_lane (C,)): each character's way, turned out of the lanes of the moving
+    boxes slower than its top speed that will reach its feet (its rest radius and the threat margin) within
+    :data:`LANE_HORIZON`: square out of the lane, to the side the character is on, keeping only the
+    part of its way that runs ahead of the box."""
+    n = state.pelvis.shape[0]
+    obs = model.raster.obstacles
+    in_lane = np.zeros(n, np.bool_)
+    if not len(obs.yaws) or bool(np.all(obs.is_static)):
+        return direction, in_lane
+    moving = np.flatnonzero(~np.asarray(obs.is_static))
+    now, yaws = obs.poses_at(state.t)
+    later, _ = obs.poses_at(state.t + model.dt)
+    velocity = (later - now)[moving][:, [0, 2]] / model.dt  # (B, 2)
+    speed = np.hypot(velocity[:, 0], velocity[:, 1])
+    # A box at least as fast as the creature's top speed has no escape (its contacts are counted as
+    # unavoidable_contacts): the feet step away from it (stage_requests) and re-plan swings it crosses.
+    go = (speed > 1e-6) & (speed < model.top_speed)
+    if not go.any():
+        return direction, in_lane
+    moving, velocity, speed = moving[go], velocity[go], speed[go]
+    u = velocity / speed[:, None]  # (B, 2) along the box's travel
+    side_axis = np.column_stack([-u[:, 1], u[:, 0]])
+    half = 0.5 * np.asarray(obs.sizes, dtype=np.float64)[moving][:, [0, 2]]
+    ax = np.column_stack([np.cos(yaws[moving]), np.sin(yaws[moving])])
+    az = np.column_stack([-np.sin(yaws[moving]), np.cos(yaws[moving])])
+    half_along = half[:, 0] * np.abs((ax * u).sum(1)) + half[:, 1] * np.abs((az * u).sum(1))
+    half_across = half[:, 0] * np.abs((ax * side_axis).sum(1)) + half[:, 1] * np.abs((az * side_axis).sum(1))
+    room = model.rest_radius + model.controller.threat_margin
+    rel = state.pelvis[:, None, [0, 2]] - now[moving][None, :, [0, 2]]  # (C, B, 2) box -> pelvis
+    along = (rel * u[None]).sum(-1)
+    across = (rel * side_axis[None]).sum(-1)
+    threat = ((np.abs(across) < half_across[None] + room) & (along > -(half_along[None] + room))
+              & (along - half_along[None] - room < speed[None] * LANE_HORIZON))
+    in_lane = threat.any(axis=1)
+    if not in_lane.any():
+        return direction, in_lane
+    # The nearer side; a character dead centre takes the side of its way (the right one if none).
+    way_side = (direction[:, None, :] * side_axis[None]).sum(-1)
+    side = np.where(np.abs(across) > 1e-6, np.sign(across), np.where(way_side > 0.0, 1.0, -1.0))
+    ahead = np.maximum((direction[:, None, :] * u[None]).sum(-1), 0.0)
+    exit_way = side[..., None] * side_axis[None] + 0.5 * ahead[..., None] * u[None]  # (C, B, 2)
+    exit_way = (exit_way * threat[..., None]).sum(axis=1)
+    norm = np.hypot(exit_way[:, 0], exit_way[:, 1])
+    turn = in_lane & (norm > 1e-9)
+    direction = direction.copy()
+    direction[turn] = exit_way[turn] / norm[turn, None]
+    return direction, turn
+
+
 def _avoid(model: CrowdModel, state: CrowdState, preferred: np.ndarray, to_target: np.ndarray):
     """(velocity (C, 2), avoided (C,) bool): ORCA's velocity for every character, and whether it
     differs from the preferred one (a neighbour or a box is in the way)."""
@@ -411,11 +472,15 @@ def _avoid(model: CrowdModel, state: CrowdState, preferred: np.ndarray, to_targe
         now, yaws = obs.poses_at(state.t)
         later, _ = obs.poses_at(state.t + model.dt)
         active = np.asarray(obs.forbidden) | ~np.asarray(obs.is_static)
+        # A moving box is kept clear of the feet, not only of the body: the character's rest radius
+        # (a stance foot the box reaches must step away, and may find nowhere to go).
+        pad = np.where(np.asarray(obs.is_static), 0.0, max(model.rest_radius - radius, 0.0))
         boxes = (np.ascontiguousarray(now[:, [0, 2]]), np.ascontiguousarray(0.5 * np.asarray(obs.sizes)[:, [0, 2]]),
                  np.ascontiguousarray(yaws, dtype=np.float64),
-                 np.ascontiguousarray((later - now)[:, [0, 2]] / model.dt), np.ascontiguousarray(active))
+                 np.ascontiguousarray((later - now)[:, [0, 2]] / model.dt), np.ascontiguousarray(active),
+                 np.ascontiguousarray(pad, dtype=np.float64))
     else:
-        boxes = (np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), np.zeros((0, 2)), np.zeros(0, np.bool_))
+        boxes = (np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), np.zeros((0, 2)), np.zeros(0, np.bool_), np.zeros(0))
     velocity = np.stack([np.cos(state.heading), np.sin(state.heading)], axis=1) * state.speed[:, None]
     out = np.empty((n, 2))
     orca_velocities(xz, np.ascontiguousarray(velocity), np.ascontiguousarray(preferred), np.full(n, radius),
@@ -695,7 +760,12 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, fre
     dx, dz = state.feet[..., 0] - hips[..., 0], state.feet[..., 2] - hips[..., 2]
     ahead = walking[:, None] & (dx * np.cos(state.heading)[:, None] + dz * np.sin(state.heading)[:, None] > 0.0)
     far = (np.hypot(dx, dz) > _reach_xz(model)[None, :]) & ~ahead
-    cannot_follow = _stance_unreachable_ahead(model, state, hips, frequency)
+    # A foot its leg lost in the last frame (the pose was taken back: the look-ahead missed the
+    # hull's rise after a lift-off) steps too. The look-ahead alone, from a body held still, found
+    # it reachable again: the body moved, lost it, and was held again, for good (a spider stood
+    # 100 frames while a crate ran over it).
+    state.unfollowed &= state.in_stance
+    cannot_follow = _stance_unreachable_ahead(model, state, hips, frequency) | state.unfollowed
     # A stance foot at the rear end of its window steps now: the body cannot move on without it
     # (stance_speed_cap holds the body back), and its sector may be a cycle away.
     # A stance foot that holds the body under half its goal speed (stance_speed_cap) steps now too:
@@ -1150,6 +1220,7 @@ def _take_back_unfollowed_poses(model: CrowdModel, state: CrowdState, on_screen:
     state.speed[bad] = 0.0
     state.body_held[bad] = True
     state.cannot_follow[bad] |= failed[bad]
+    state.unfollowed[bad] |= failed[bad]
     hips = hips_world(model, state)
     for stance, iterations, restarts in ((True, ctl.ik_iterations, ctl.ik_restarts),
                                          (False, ctl.ik_swing_iterations, 0)):
@@ -1352,7 +1423,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         plan_heading=np.repeat(headings[:, None], L, axis=1), plan_speed=np.zeros((n, L)),
         feet_spacing=np.ones(n), plan_spacing=np.ones((n, L)), foot_yaws=yaws,
         gaits=init_gaits([schedule.gaits[int(k)] for k in gait_index], n, rng.uniform(0.0, 1.0, n), transition_rate=TRANSITION_RATE), angles=angles, residual=np.zeros((n, L)),
-        ik_on=np.zeros(n, np.bool_), fk_feet=feet.copy(), hull=np.zeros(n), pelvis_rise=np.zeros(n), body_held=np.zeros(n, np.bool_), speed_limit=np.full(n, np.inf), last_move=np.zeros((n, 2)), cannot_follow=np.zeros((n, L), np.bool_), pose_before=np.zeros((n, 6)),
+        ik_on=np.zeros(n, np.bool_), fk_feet=feet.copy(), hull=np.zeros(n), pelvis_rise=np.zeros(n), body_held=np.zeros(n, np.bool_), speed_limit=np.full(n, np.inf), last_move=np.zeros((n, 2)), cannot_follow=np.zeros((n, L), np.bool_), unfollowed=np.zeros((n, L), np.bool_), pose_before=np.zeros((n, 6)),
         gait_index=gait_index, stride_frequency=np.zeros(n),
         counters={k: 0 for k in ("steps", "plans", "holds", "replans", "forbidden_footprints", "cells_expanded",
                                  "couples_evaluated", "pose_takebacks", "map_cells_built", "ik_ccd_legs", "ik_two_bone_legs")},

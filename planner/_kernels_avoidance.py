@@ -213,8 +213,8 @@ def _cone_line(px, py, vx, vy, r, tau, dt, share, ax, ay, out_point, out_dir, k)
 
 @nb.njit(cache=True, parallel=True)
 def orca_velocities(positions, velocities, preferred, radii, max_speed, neighbour_start, neighbour_index,
-                    box_centres, box_half, box_yaws, box_velocities, box_active, time_horizon, box_time_horizon, dt,
-                    out):
+                    box_centres, box_half, box_yaws, box_velocities, box_active, box_pad, time_horizon,
+                    box_time_horizon, dt, out):
     """New velocity (C, 2) of every character: closest to ``preferred`` among those that avoid
     every neighbour for ``time_horizon`` seconds (sharing the effort) and every active box for
     ``box_time_horizon`` seconds (alone), at most ``max_speed``.
@@ -222,7 +222,7 @@ def orca_velocities(positions, velocities, preferred, radii, max_speed, neighbou
     positions, velocities, preferred: (C, 2) world (x, z); radii, max_speed: (C,); neighbours in
     CSR form (character c's are ``neighbour_index[neighbour_start[c]:neighbour_start[c + 1]]``);
     boxes: centres (B, 2), half extents (B, 2) along their axes, yaws (B,), velocities (B, 2),
-    ``box_active`` (B,) bool.
+    ``box_active`` (B,) bool, ``box_pad`` (B,) m added to a character's radius against that box.
     """
     n = positions.shape[0]
     for c in nb.prange(n):
@@ -239,11 +239,12 @@ def orca_velocities(positions, velocities, preferred, radii, max_speed, neighbou
         for b in range(box_centres.shape[0]):
             if not box_active[b]:
                 continue
+            rb = ra + box_pad[b]
             qx, qz, inside = _nearest_on_box(pax, paz, box_centres[b, 0], box_centres[b, 1], box_half[b, 0],
                                              box_half[b, 1], box_yaws[b])
             rel_x, rel_z = qx - pax, qz - paz
             dist = math.hypot(rel_x, rel_z)
-            reach = (speed + math.hypot(box_velocities[b, 0], box_velocities[b, 1])) * box_time_horizon + ra
+            reach = (speed + math.hypot(box_velocities[b, 0], box_velocities[b, 1])) * box_time_horizon + rb
             if not inside and dist > reach:
                 continue
             if inside:
@@ -252,13 +253,13 @@ def orca_velocities(positions, velocities, preferred, radii, max_speed, neighbou
                 if dist < EPSILON:
                     rel_x, rel_z, dist = 1.0, 0.0, 1.0
                 nx, nz = rel_x / dist, rel_z / dist
-                out_speed = box_velocities[b, 0] * nx + box_velocities[b, 1] * nz + min((ra + dist) / dt, speed)
+                out_speed = box_velocities[b, 0] * nx + box_velocities[b, 1] * nz + min((rb + dist) / dt, speed)
                 directions[k, 0] = nz
                 directions[k, 1] = -nx
                 points[k, 0] = out_speed * nx
                 points[k, 1] = out_speed * nz
             else:
-                _cone_line(rel_x, rel_z, vax - box_velocities[b, 0], vaz - box_velocities[b, 1], ra,
+                _cone_line(rel_x, rel_z, vax - box_velocities[b, 0], vaz - box_velocities[b, 1], rb,
                            box_time_horizon, dt, 1.0, vax, vaz, points, directions, k)
             k += 1
         n_box_lines = k

@@ -12,7 +12,7 @@ from planner._kernels_avoidance import neighbour_lists, orca_velocities
 
 DT = 1.0 / 30.0
 TAU = 2.0
-NO_BOXES = (np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), np.zeros((0, 2)), np.zeros(0, np.bool_))
+NO_BOXES = (np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), np.zeros((0, 2)), np.zeros(0, np.bool_), np.zeros(0))
 
 
 def _step(pos, vel, pref, radii, vmax, boxes=NO_BOXES, tau=TAU, box_tau=1.0):
@@ -108,7 +108,7 @@ def test_a_crowd_passes_a_doorway_without_overlap_or_entering_the_walls():
     # from x < -1 to goals beyond the wall.
     half = np.array([[0.1, 1.0], [0.1, 1.0]])
     centres = np.array([[0.0, 1.4], [0.0, -1.4]])
-    boxes = (centres, half, np.zeros(2), np.zeros((2, 2)), np.ones(2, np.bool_))
+    boxes = (centres, half, np.zeros(2), np.zeros((2, 2)), np.ones(2, np.bool_), np.zeros(2))
     rng = np.random.default_rng(3)
     start = np.column_stack([rng.uniform(-2.5, -1.2, 10), np.linspace(-1.5, 1.5, 10)])
     goals = np.column_stack([np.full(10, 2.0), np.linspace(-1.5, 1.5, 10)])
@@ -132,7 +132,7 @@ def test_a_crate_driven_at_a_standing_character_is_evaded():
     velocity = np.array([[0.2, 0.0]])
 
     def boxes_at(t):
-        return (np.array([[-2.0 + 0.2 * t, 0.0]]), half, np.zeros(1), velocity, np.ones(1, np.bool_))
+        return (np.array([[-2.0 + 0.2 * t, 0.0]]), half, np.zeros(1), velocity, np.ones(1, np.bool_), np.zeros(1))
 
     trail = _walk([[0.0, 0.0]], np.array([[0.0, 0.0]]), np.array([0.2]), np.array([0.5]), 600, boxes_at=boxes_at,
                   box_tau=2.0)
@@ -165,3 +165,16 @@ def test_neighbour_lists_keep_the_nearest_when_capped():
     start, index = neighbour_lists(pos, 1.0, max_neighbours=2)
     lists = [index[start[i]:start[i + 1]].tolist() for i in range(5)]
     assert lists == [[1, 2], [0, 3], [0, 1], [0, 1], []]
+
+
+@pytest.mark.parametrize("pad, expected", [(0.0, 0.6), (0.3, 0.3)])
+def test_a_box_pad_widens_the_disc_against_that_box(pad, expected):
+    # A character of radius 0.2 at the origin wants 1 m/s toward a box whose near side is 0.8 m
+    # ahead (centre (1, 0), half extents 0.2). Straight at it, ORCA's cut-off circle (centre p/tau,
+    # radius r/tau, tau = 1 s) allows (0.8 - r) / tau: 0.6 m/s with the character's radius, 0.3 m/s
+    # with a 0.3 m pad (a moving box is kept clear of the feet, not only of the body).
+    boxes = (np.array([[1.0, 0.0]]), np.array([[0.2, 0.2]]), np.zeros(1), np.zeros((1, 2)), np.ones(1, np.bool_),
+             np.array([pad]))
+    out = _step(np.zeros((1, 2)), np.zeros((1, 2)), np.array([[1.0, 0.0]]), np.array([0.2]), np.array([2.0]),
+                boxes, box_tau=1.0)
+    np.testing.assert_allclose(out[0], [expected, 0.0], atol=1e-9)

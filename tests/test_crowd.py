@@ -248,6 +248,31 @@ def test_a_hold_lowers_the_speed_limit_and_a_step_begun_standing_takes_the_walks
     assert state.swing_T[0, 0] < 1.0 / frequency  # one stride at most; the 1 s cap before
 
 
+def test_a_stance_foot_whose_leg_lost_it_steps_next_frame():
+    """A pose taken back because a stance leg lost its foot (``unfollowed``) makes that foot step in
+    the next requests, even though the look-ahead from the held body finds it reachable again: the
+    body stood, moved, lost the foot and stood again, for good, while a crate ran over it."""
+    from planner._crowd import ControllerConfig, stage_requests, step
+
+    scenario, creature = load_scenario("flat"), load_creature("ant")
+    model, state = init_crowd(scenario, creature, load_gait(default_gait_name("ant"), creature), n_characters=1,
+                              seed=0, lod_mode="off", raster=_raster(scenario, creature), controller=ControllerConfig())
+    for _ in range(30):
+        step(model, state)
+    state.in_stance[0] = True
+    state.wants_swing[0] = False
+    state.sector_missed[0] = False
+    state.speed[0] = 0.0  # held: the look-ahead finds every foot reachable
+    args = (np.zeros_like(state.in_stance), _no_boxes(), hips_world(model, state), np.array([1e-6]))
+    before = (state.cannot_follow.copy(), state.unfollowed.copy())
+    assert not (stage_requests(model, state, *args)[0] == 2).any()
+    state.cannot_follow[:], state.unfollowed[:] = before
+    state.unfollowed[0, 3] = True
+    kinds = stage_requests(model, state, *args)
+    assert kinds[0, 3] == 2 and (kinds[0] == 2).sum() == 1
+    assert not state.body_held[0]
+
+
 def _no_boxes():
     z3 = np.zeros((0, 3))
     return z3, z3, np.zeros(0), np.zeros(0, np.bool_), np.zeros(0, np.bool_)
