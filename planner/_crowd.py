@@ -167,6 +167,7 @@ class CrowdModel:
     # both on compact maps; None with lod_mode 'off' (every character plans as the paper does).
     far_first: PlannerConfig | None = None
     far_fallback: PlannerConfig | None = None
+    avoid_radius: float = math.nan  # m, the disc its characters keep clear of each other (avoid_radius)
 
     @property
     def n_legs(self) -> int:
@@ -378,9 +379,15 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
         fb[idx] -= move
 
 
-AVOID_RADIUS = 0.6
-"""x rest radius: the disc a character keeps clear of others (less than half the spawn spacing, so a crowd
-spawned as promised starts clear) and of forbidden and moving boxes."""
+AVOID_RADIUS = 1.0
+"""x crowd radius: the most a character keeps clear of others and of forbidden and moving boxes: its
+legs' span, so that the feet of neighbours walking in file or abreast do not compete for the same
+spots (6 ants on flat ground, spawned 1.8 rest radii apart and kept so by a 0.6 disc: 10 % of their
+strides were more than 15 % off the stride law; 2 % with the full span)."""
+AVOID_RADIUS_MIN = 0.6
+"""x crowd radius: the least: the body. A crowd spawned denser than its legs' span (a big crowd in a
+small world) keeps the spacing it was spawned at (:func:`avoid_radius`): ORCA pushes characters that
+start inside each other's disc apart within a frame."""
 AVOID_HORIZON = 2.0
 """s: ORCA's time horizon between characters."""
 AVOID_BOX_HORIZON = 1.5
@@ -428,8 +435,12 @@ def _lane_exit(model: CrowdModel, state: CrowdState, direction: np.ndarray):
     rel = state.pelvis[:, None, [0, 2]] - now[moving][None, :, [0, 2]]  # (C, B, 2) box -> pelvis
     along = (rel * u[None]).sum(-1)
     across = (rel * side_axis[None]).sum(-1)
+    # The box and the character close in at the box's speed plus the character's own toward it.
+    walk = state.speed[:, None] * (np.cos(state.heading)[:, None] * u[None, :, 0]
+                                   + np.sin(state.heading)[:, None] * u[None, :, 1])  # (C, B) along u
+    closing = speed[None] + np.maximum(-walk, 0.0)
     threat = ((np.abs(across) < half_across[None] + room) & (along > -(half_along[None] + room))
-              & (along - half_along[None] - room < speed[None] * LANE_HORIZON))
+              & (along - half_along[None] - room < closing * LANE_HORIZON))
     in_lane = threat.any(axis=1)
     if not in_lane.any():
         return direction, in_lane
@@ -453,7 +464,7 @@ def _avoid(model: CrowdModel, state: CrowdState, preferred: np.ndarray, to_targe
 
     n = state.pelvis.shape[0]
     xz = np.ascontiguousarray(state.pelvis[:, [0, 2]])
-    radius = AVOID_RADIUS * crowd_radius(model.creature, model.rest_radius)
+    radius = model.avoid_radius
     top = model.top_speed if math.isfinite(model.top_speed) else float(np.max(state.desired_speed))
     start, index = neighbour_lists(xz, 2.0 * radius + 2.0 * top * AVOID_HORIZON, AVOID_NEIGHBOURS)
     near = np.zeros(n, np.bool_)
@@ -1237,7 +1248,7 @@ def _take_back_unfollowed_poses(model: CrowdModel, state: CrowdState, on_screen:
 # ----------------------------------------------------------------------------- set-up
 def crowd_radius(creature, rest_radius: float | None = None) -> float:
     """m: the radius a character takes in a crowd: its rest radius (``rest_radius``, the creature's by
-    default), or more for a body box that reaches beyond :data:`AVOID_RADIUS` of it (a quadruped's
+    default), or more for a body box that reaches beyond :data:`AVOID_RADIUS_MIN` of it (a quadruped's
     0.6 m body: the avoidance disc covers the body, and spawns 1.5 such radii apart cannot overlap).
 
     Examples
@@ -1246,14 +1257,37 @@ def crowd_radius(creature, rest_radius: float | None = None) -> float:
     >>> spider, dog = load_creature("spider"), load_creature("quadruped")
     >>> crowd_radius(spider) == float(spider.rest_radius)
     True
-    >>> round(AVOID_RADIUS * crowd_radius(dog), 3) == round(0.5 * float(np.hypot(*dog.body_box)), 3)
+    >>> round(AVOID_RADIUS_MIN * crowd_radius(dog), 3) == round(0.5 * float(np.hypot(*dog.body_box)), 3)
     True
     """
     rest = float(creature.rest_radius) if rest_radius is None else float(rest_radius)
-    return max(rest, 0.5 * float(np.hypot(*creature.body_box)) / AVOID_RADIUS)
+    return max(rest, 0.5 * float(np.hypot(*creature.body_box)) / AVOID_RADIUS_MIN)
 
 
-def spawn_positions(scenario, creature, n: int, spacing_factor: float = 1.5):
+def avoid_radius(creature, rest_radius: float, positions: np.ndarray) -> float:
+    """m: the disc a crowd's characters keep clear of each other: :data:`AVOID_RADIUS` x their crowd
+    radius, or half the least spacing they were spawned at (a crowd spawned denser), at least
+    :data:`AVOID_RADIUS_MIN` x it (the body).
+
+    >>> from scenarios import load_creature
+    >>> spider = load_creature("spider")
+    >>> r = crowd_radius(spider)
+    >>> avoid_radius(spider, None, np.array([[0.0, 0.0], [3.0 * r, 0.0]])) == r
+    True
+    >>> round(avoid_radius(spider, None, np.array([[0.0, 0.0], [1.5 * r, 0.0]])) / r, 3)
+    0.742
+    """
+    radius = crowd_radius(creature, rest_radius)
+    positions = np.asarray(positions, dtype=np.float64)
+    if positions.shape[0] < 2:
+        return AVOID_RADIUS * radius
+    from scipy.spatial import cKDTree
+
+    gap = float(cKDTree(positions).query(positions, k=2)[0][:, 1].min())
+    return float(np.clip(0.5 * 0.99 * gap, AVOID_RADIUS_MIN * radius, AVOID_RADIUS * radius))
+
+
+def spawn_positions(scenario, creature, n: int, spacing_factor: float = 2.1):
     """n start positions (x, z) on a sunflower spiral around the crowd centre, clear of boxes.
 
     Creatures are ``spacing_factor`` x their crowd radius (:func:`crowd_radius`, the rest radius
@@ -1269,7 +1303,7 @@ def spawn_positions(scenario, creature, n: int, spacing_factor: float = 1.5):
     x0, x1 = scenario.terrain.x_range
     z0, z1 = scenario.terrain.z_range
     golden = math.pi * (3.0 - math.sqrt(5.0))
-    for factor in (spacing_factor, 1.25, 1.0):
+    for factor in (spacing_factor, 1.5, 1.25, 1.0):
         spacing = factor * rest
         m = 8 * n + 64
         k = np.arange(m)
@@ -1391,6 +1425,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         far_fallback=far_fallback)
     rng = np.random.default_rng(seed)
     positions = spawn_positions(scenario, creature, n)
+    model = dataclasses.replace(model, avoid_radius=avoid_radius(creature, model.rest_radius, positions))
     if scenario.crowd.heading_mode == "random":
         headings = rng.uniform(-math.pi, math.pi, n)
     else:

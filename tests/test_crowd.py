@@ -31,7 +31,11 @@ def _raster(scenario, creature):
 # Found by the counters on the rendered pose (planner._counters) and not fixed yet; strict: when one
 # is fixed, its runs must pass. (A quadruped's knees crossed on hills, folded under the body by a leg
 # plane turned inward: fixed in the IK, planner._kernels_ik._knee_inward.)
-KNOWN_DEFECTS: dict[tuple[str, str], str] = {}
+KNOWN_DEFECTS: dict[tuple[str, str], str] = {
+    ("quadruped", "stairs"): "open defect (issue 14): with crowds spawned a leg span apart, seed 8 (3 quadrupeds, "
+    "LOD zoomed) has one frame where a swinging hind leg's hock meets the other hind leg under the body (frame 30, "
+    "walking straight at 0.3 m/s); the legs have no abduction joint to keep them apart",
+}
 
 
 @pytest.mark.parametrize("scenario_name", builtin_scenario_names())
@@ -369,7 +373,7 @@ def test_a_crowd_spawns_with_every_foot_a_foots_room_from_the_other_characters_f
 
 
 def test_a_crowds_feet_keep_a_foots_room_from_each_other():
-    """8 spiders on ``crates``: no two stance feet of different characters closer than a foot length
+    """16 spiders on ``crates``: no two stance feet of different characters closer than a foot length
     (``shared_foot_spots``), because every planned foot keeps a foot's room from the other characters'
     feet near it (where they stand, or will land). Without that, the same run shares spots."""
     import dataclasses
@@ -378,7 +382,7 @@ def test_a_crowds_feet_keep_a_foots_room_from_each_other():
     counts = {}
     for avoid in (True, False):
         model, state = init_crowd(scenario, creature, load_gait(default_gait_name("spider"), creature),
-                                  n_characters=8, seed=5, lod_mode="off", raster=_raster(scenario, creature))
+                                  n_characters=16, seed=5, lod_mode="off", raster=_raster(scenario, creature))
         model = dataclasses.replace(model, controller=dataclasses.replace(model.controller, avoid_others_feet=avoid))
         counts[avoid] = simulate(model, state, 200).shared_foot_spots
     assert counts[True] == 0
