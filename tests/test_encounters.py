@@ -230,3 +230,24 @@ def test_a_crate_driven_head_on_at_a_walking_spider_is_evaded(tmp_path, walk, cr
     assert counters.collisions == 0
     assert counters.max_stance_slip_m <= 1e-3
     assert state.pelvis[0, 0] > 0.5, "the spider walks on past the crate"
+
+
+def test_a_character_in_a_crates_lane_heads_square_out_of_it_to_the_nearer_side(tmp_path):
+    # A 0.5 m crate at (1, 0) drives -x at 0.2 m/s at a spider standing at the origin (facing +x, its
+    # way +x): the crate's front (0.75) reaches its feet (rest radius + threat margin, 0.38 m) in
+    # 1.9 s, under 3 s, so its way turns square out of the lane. Dead
+    # centre, it takes the side of its way's right (+z: the lane's side axis for a crate going -x is
+    # (0, -1), and the way has no part along it, so the tie goes to +z); 0.1 m to -z, it takes -z.
+    # Behind the crate, or beside its lane, the way is kept.
+    from planner._crowd import _lane_exit
+
+    model, state = _world(tmp_path, "lane", crate_centre=(1.0, 0.0), crate_width=0.5, start=(0.0, 0.0),
+                          goal=(4.0, 0.0), velocity=(-0.2, 0.0))
+    way = np.array([[1.0, 0.0]])
+    for z, expected in ((0.0, [0.0, 1.0]), (-0.1, [0.0, -1.0]), (0.5 * 0.5 + model.rest_radius + 0.1, [1.0, 0.0])):
+        state.pelvis[0, [0, 2]] = [0.0, z]
+        direction, in_lane = _lane_exit(model, state, way)
+        np.testing.assert_allclose(direction[0], expected, atol=1e-12)
+        assert in_lane[0] == (expected != [1.0, 0.0])
+    state.pelvis[0, [0, 2]] = [2.0, 0.0]  # behind the crate
+    assert not _lane_exit(model, state, way)[1][0]
