@@ -383,7 +383,7 @@ AVOID_RADIUS = 1.0
 """x crowd radius: the most a character keeps clear of others and of forbidden and moving boxes: its
 legs' span, so that the feet of neighbours walking in file or abreast do not compete for the same
 spots (6 ants on flat ground, spawned 1.8 rest radii apart and kept so by a 0.6 disc: 10 % of their
-strides were more than 15 % off the stride law; 2 % with the full span)."""
+strides were more than 15 % off the stride law, p90 15.7 %; 6.6 % with the full span)."""
 AVOID_RADIUS_MIN = 0.6
 """x crowd radius: the least: the body. A crowd spawned denser than its legs' span (a big crowd in a
 small world) keeps the spacing it was spawned at (:func:`avoid_radius`): ORCA pushes characters that
@@ -444,7 +444,8 @@ def _lane_exit(model: CrowdModel, state: CrowdState, direction: np.ndarray):
     in_lane = threat.any(axis=1)
     if not in_lane.any():
         return direction, in_lane
-    # The nearer side; a character dead centre takes the side of its way (the right one if none).
+    # The nearer side; a character dead centre takes the side its way leans to (a way with no part
+    # across the lane: the side of -side_axis, a fixed convention so that the choice is deterministic).
     way_side = (direction[:, None, :] * side_axis[None]).sum(-1)
     side = np.where(np.abs(across) > 1e-6, np.sign(across), np.where(way_side > 0.0, 1.0, -1.0))
     ahead = np.maximum((direction[:, None, :] * u[None]).sum(-1), 0.0)
