@@ -322,7 +322,8 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
     # Out of a moving box's lane: a character the box will reach within LANE_HORIZON heads out of
     # its path, to the nearer side, before ORCA (which, for a walker that only goes forward, settles
     # on slowing down in the lane until the box is on it).
-    direction, in_lane = _lane_exit(model, state, direction)
+    box_velocity = _box_velocities(model, state.t, centres)
+    direction, in_lane = _lane_exit(model, state, direction, boxes, box_velocity)
     # Reciprocal avoidance (ORCA) of the other characters and of forbidden or moving boxes: the
     # velocity closest to the preferred one that stays clear for the horizon.
     # Arriving: on the last leg of its route a character brakes in time (at its acceleration) to
@@ -330,7 +331,7 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
     braking = np.where(state.route_index == last, arrival_speed(dist, ctl.arrive_radius, ctl.acceleration), np.inf)
     goal_speed = np.where(arrived, 0.0, np.minimum(np.minimum(state.desired_speed, state.speed_limit), braking))
     preferred = direction * goal_speed[:, None]
-    velocity, avoided = _avoid(model, state, preferred, dist)
+    velocity, avoided = _avoid(model, state, preferred, dist, boxes, box_velocity)
     fast = np.hypot(velocity[:, 0], velocity[:, 1]) > 1e-6
     direction = np.where((avoided & fast)[:, None], velocity / np.maximum(np.hypot(*velocity.T), 1e-12)[:, None],
                          direction)
@@ -403,20 +404,35 @@ LANE_HORIZON = 3.0
 """s: a moving box that will reach a character within this time makes it leave the box's lane."""
 
 
-def _lane_exit(model: CrowdModel, state: CrowdState, direction: np.ndarray):
+def _box_velocities(model: CrowdModel, t: float, centres: np.ndarray) -> np.ndarray:
+    """(B, 2) m/s: each box's velocity on the ground over the next frame (``centres``: where it is at t)."""
+    obs = model.raster.obstacles
+    if not len(obs.yaws):
+        return np.zeros((0, 2))
+    later, _ = obs.poses_at(t + model.dt)
+    return (later - centres)[:, [0, 2]] / model.dt
+
+
+def _half_extents_along(half: np.ndarray, yaws: np.ndarray, axis: np.ndarray) -> np.ndarray:
+    """(B,) how far each box (half extents (B, 2) along its yawed axes) reaches along ``axis`` (B, 2)."""
+    cos, sin = np.cos(yaws), np.sin(yaws)
+    return (half[:, 0] * np.abs(cos * axis[:, 0] + sin * axis[:, 1])
+            + half[:, 1] * np.abs(-sin * axis[:, 0] + cos * axis[:, 1]))
+
+
+def _lane_exit(model: CrowdModel, state: CrowdState, direction: np.ndarray, boxes, box_velocity: np.ndarray):
     """(direction (C, 2), in_lane (C,)): each character's way, turned out of the lanes of the moving
     boxes slower than its top speed that will reach its feet (its rest radius and the threat margin) within
     :data:`LANE_HORIZON`: square out of the lane, to the side the character is on, keeping only the
-    part of its way that runs ahead of the box."""
+    part of its way that runs ahead of the box. ``boxes`` as :func:`_boxes_now` gives them,
+    ``box_velocity`` from :func:`_box_velocities`."""
     n = state.pelvis.shape[0]
-    obs = model.raster.obstacles
+    centres, sizes, yaws, _, moving = boxes
     in_lane = np.zeros(n, np.bool_)
-    if not len(obs.yaws) or bool(np.all(obs.is_static)):
+    if not moving.any():
         return direction, in_lane
-    moving = np.flatnonzero(~np.asarray(obs.is_static))
-    now, yaws = obs.poses_at(state.t)
-    later, _ = obs.poses_at(state.t + model.dt)
-    velocity = (later - now)[moving][:, [0, 2]] / model.dt  # (B, 2)
+    moving = np.flatnonzero(moving)
+    velocity = box_velocity[moving]  # (B, 2)
     speed = np.hypot(velocity[:, 0], velocity[:, 1])
     # A box at least as fast as the creature's top speed has no escape (its contacts are counted as
     # unavoidable_contacts): the feet step away from it (stage_requests) and re-plan swings it crosses.
@@ -426,13 +442,11 @@ def _lane_exit(model: CrowdModel, state: CrowdState, direction: np.ndarray):
     moving, velocity, speed = moving[go], velocity[go], speed[go]
     u = velocity / speed[:, None]  # (B, 2) along the box's travel
     side_axis = np.column_stack([-u[:, 1], u[:, 0]])
-    half = 0.5 * np.asarray(obs.sizes, dtype=np.float64)[moving][:, [0, 2]]
-    ax = np.column_stack([np.cos(yaws[moving]), np.sin(yaws[moving])])
-    az = np.column_stack([-np.sin(yaws[moving]), np.cos(yaws[moving])])
-    half_along = half[:, 0] * np.abs((ax * u).sum(1)) + half[:, 1] * np.abs((az * u).sum(1))
-    half_across = half[:, 0] * np.abs((ax * side_axis).sum(1)) + half[:, 1] * np.abs((az * side_axis).sum(1))
+    half = 0.5 * sizes[moving][:, [0, 2]]
+    half_along = _half_extents_along(half, yaws[moving], u)
+    half_across = _half_extents_along(half, yaws[moving], side_axis)
     room = model.rest_radius + model.controller.threat_margin
-    rel = state.pelvis[:, None, [0, 2]] - now[moving][None, :, [0, 2]]  # (C, B, 2) box -> pelvis
+    rel = state.pelvis[:, None, [0, 2]] - centres[moving][None, :, [0, 2]]  # (C, B, 2) box -> pelvis
     along = (rel * u[None]).sum(-1)
     across = (rel * side_axis[None]).sum(-1)
     # The box and the character close in at the box's speed plus the character's own toward it.
@@ -458,9 +472,11 @@ def _lane_exit(model: CrowdModel, state: CrowdState, direction: np.ndarray):
     return direction, turn
 
 
-def _avoid(model: CrowdModel, state: CrowdState, preferred: np.ndarray, to_target: np.ndarray):
+def _avoid(model: CrowdModel, state: CrowdState, preferred: np.ndarray, to_target: np.ndarray, boxes,
+           box_velocity: np.ndarray):
     """(velocity (C, 2), avoided (C,) bool): ORCA's velocity for every character, and whether it
-    differs from the preferred one (a neighbour or a box is in the way)."""
+    differs from the preferred one (a neighbour or a box is in the way). ``boxes`` as
+    :func:`_boxes_now` gives them, ``box_velocity`` from :func:`_box_velocities`."""
     from planner._kernels_avoidance import neighbour_lists, orca_velocities
 
     n = state.pelvis.shape[0]
@@ -479,24 +495,16 @@ def _avoid(model: CrowdModel, state: CrowdState, preferred: np.ndarray, to_targe
         p = preferred[turn]
         preferred = preferred.copy()
         preferred[turn] = np.column_stack([c * p[:, 0] - s * p[:, 1], s * p[:, 0] + c * p[:, 1]])
-    obs = model.raster.obstacles
-    if len(obs.yaws):
-        now, yaws = obs.poses_at(state.t)
-        later, _ = obs.poses_at(state.t + model.dt)
-        active = np.asarray(obs.forbidden) | ~np.asarray(obs.is_static)
-        # A moving box is kept clear of the feet, not only of the body: the character's rest radius
-        # (a stance foot the box reaches must step away, and may find nowhere to go).
-        pad = np.where(np.asarray(obs.is_static), 0.0, max(model.rest_radius - radius, 0.0))
-        boxes = (np.ascontiguousarray(now[:, [0, 2]]), np.ascontiguousarray(0.5 * np.asarray(obs.sizes)[:, [0, 2]]),
-                 np.ascontiguousarray(yaws, dtype=np.float64),
-                 np.ascontiguousarray((later - now)[:, [0, 2]] / model.dt), np.ascontiguousarray(active),
-                 np.ascontiguousarray(pad, dtype=np.float64))
-    else:
-        boxes = (np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), np.zeros((0, 2)), np.zeros(0, np.bool_), np.zeros(0))
+    centres, sizes, yaws, forbidden, moving = boxes
+    # A moving box is kept clear of the feet, not only of the body: the character's rest radius
+    # (a stance foot the box reaches must step away, and may find nowhere to go).
+    pad = np.where(moving, max(model.rest_radius - radius, 0.0), 0.0)
+    orca_boxes = (np.ascontiguousarray(centres[:, [0, 2]]), np.ascontiguousarray(0.5 * sizes[:, [0, 2]]), yaws,
+                  np.ascontiguousarray(box_velocity), forbidden | moving, pad)
     velocity = np.stack([np.cos(state.heading), np.sin(state.heading)], axis=1) * state.speed[:, None]
     out = np.empty((n, 2))
     orca_velocities(xz, np.ascontiguousarray(velocity), np.ascontiguousarray(preferred), np.full(n, radius),
-                    np.full(n, top), start, index, *boxes, AVOID_HORIZON, AVOID_BOX_HORIZON, model.dt, out)
+                    np.full(n, top), start, index, *orca_boxes, AVOID_HORIZON, AVOID_BOX_HORIZON, model.dt, out)
     avoided = np.hypot(*(out - preferred).T) > 1e-9
     return out, avoided
 

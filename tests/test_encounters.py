@@ -110,7 +110,7 @@ def test_a_crate_crossing_a_planned_swing_replans_it_the_same_frame(tmp_path, mo
     # here: it keeps the feet clear of even this crate by waiting, and this test is about the swings.
     import planner._crowd as crowd
 
-    monkeypatch.setattr(crowd, "_avoid", lambda model, state, preferred, to_target: (
+    monkeypatch.setattr(crowd, "_avoid", lambda model, state, preferred, *_: (
         preferred, np.zeros(preferred.shape[0], np.bool_)))
 
     model, state = _world(tmp_path, "across-swing", crate_centre=(-1.1, -4.0), crate_width=0.2, start=(-2.0, 0.0),
@@ -239,15 +239,19 @@ def test_a_character_in_a_crates_lane_heads_square_out_of_it_to_the_nearer_side(
     # centre, it takes the side of its way's right (+z: the lane's side axis for a crate going -x is
     # (0, -1), and the way has no part along it, so the tie goes to +z); 0.1 m to -z, it takes -z.
     # Behind the crate, or beside its lane, the way is kept.
-    from planner._crowd import _lane_exit
+    from planner._crowd import _box_velocities, _boxes_now, _lane_exit
+
+    def lane_exit(model, state, way):
+        boxes = _boxes_now(model, state.t)
+        return _lane_exit(model, state, way, boxes, _box_velocities(model, state.t, boxes[0]))
 
     model, state = _world(tmp_path, "lane", crate_centre=(1.0, 0.0), crate_width=0.5, start=(0.0, 0.0),
                           goal=(4.0, 0.0), velocity=(-0.2, 0.0))
     way = np.array([[1.0, 0.0]])
     for z, expected in ((0.0, [0.0, 1.0]), (-0.1, [0.0, -1.0]), (0.5 * 0.5 + model.rest_radius + 0.1, [1.0, 0.0])):
         state.pelvis[0, [0, 2]] = [0.0, z]
-        direction, in_lane = _lane_exit(model, state, way)
+        direction, in_lane = lane_exit(model, state, way)
         np.testing.assert_allclose(direction[0], expected, atol=1e-12)
         assert in_lane[0] == (expected != [1.0, 0.0])
     state.pelvis[0, [0, 2]] = [2.0, 0.0]  # behind the crate
-    assert not _lane_exit(model, state, way)[1][0]
+    assert not lane_exit(model, state, way)[1][0]
