@@ -23,8 +23,8 @@ def use_compilation_cache() -> Path | None:
 
     Why: a tune compiles about 250 small programs (11 s of its 29 s in ``footfall run --quick``);
     JAX keys each cached program by the program itself and JAX's version, so a changed formula
-    compiles afresh and a stale entry is never used. Returns the folder (None if JAX's cache was
-    configured by the user already)."""
+    compiles afresh and a stale entry is never used. Returns the folder, or None when a cache
+    folder is configured already (by the user, or by an earlier call: it is kept)."""
     if jax.config.jax_compilation_cache_dir:
         return None
     folder = Path(os.environ.get("FOOTFALL_JAX_CACHE_DIR") or Path.home() / ".cache" / "footfall" / "jax")
