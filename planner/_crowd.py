@@ -1273,7 +1273,7 @@ def crowd_radius(creature, rest_radius: float | None = None) -> float:
     return max(rest, 0.5 * float(np.hypot(*creature.body_box)) / AVOID_RADIUS_MIN)
 
 
-def avoid_radius(creature, rest_radius: float, positions: np.ndarray) -> float:
+def avoid_radius(creature, rest_radius: float | None, positions: np.ndarray) -> float:
     """m: the disc a crowd's characters keep clear of each other: :data:`AVOID_RADIUS` x their crowd
     radius, or half the least spacing they were spawned at (a crowd spawned denser), at least
     :data:`AVOID_RADIUS_MIN` x it (the body).
