@@ -776,7 +776,7 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, fre
     # off the law). A body turning on the spot does not walk toward them, nor does one near a moving
     # box: it turns away from the box, off the heading the foot is ahead along.
     walking = state.speed >= 0.5 * np.minimum(state.desired_speed, state.speed_limit)
-    walking &= ~moving_box_near(model, state)
+    walking &= ~moving_box_near(model, state, boxes)
     dx, dz = state.feet[..., 0] - hips[..., 0], state.feet[..., 2] - hips[..., 2]
     ahead = walking[:, None] & (dx * np.cos(state.heading)[:, None] + dz * np.sin(state.heading)[:, None] > 0.0)
     far = (np.hypot(dx, dz) > _reach_xz(model)[None, :]) & ~ahead
@@ -843,9 +843,10 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, fre
     return kinds
 
 
-def character_budgets(model: CrowdModel, state: CrowdState):
+def character_budgets(model: CrowdModel, state: CrowdState, boxes):
     """(couples_after_first (C,), slice_size (C,), on_screen (C,)) from the LOD mode and camera;
-    with a LOD mode, each character's level of detail too (``state.lod_level``, planner._lod)."""
+    with a LOD mode, each character's level of detail too (``state.lod_level``, planner._lod).
+    ``boxes``: the frame's, as :func:`_boxes_now` gives them."""
     n = state.pelvis.shape[0]
     if model.lod_mode == "off":
         c, s, _ = (model.fixed_budget or FULL_SEARCH).kernel_args()
@@ -863,26 +864,21 @@ def character_budgets(model: CrowdModel, state: CrowdState):
     # valid one (its IK keeps its level). With the first valid couple far feet stood in the crates'
     # way more often: 1000 spiders on mixed, 120 frames, seeds 0-2: 1031 feet in moving boxes,
     # 813 with LOD off, 839 with two couples near the crates.
-    near = moving_box_near(model, state)
+    near = moving_box_near(model, state, boxes)
     state.near_moving_box = near
     couples = np.where(near, np.maximum(couples, model.lod.moving_box_couples), couples)
     return couples, slices, on_screen
 
 
-def moving_box_near(model: CrowdModel, state: CrowdState) -> np.ndarray:
+def moving_box_near(model: CrowdModel, state: CrowdState, boxes) -> np.ndarray:
     """(C,) characters within ``LodConfig.moving_box_margin_m`` of a moving box's reach: the box's
     bounding circle grown by how far the character's feet plan (its rest radius, candidate disc and
-    leg reach) and the margin."""
-    obs = model.raster.obstacles
-    n = state.pelvis.shape[0]
-    if not len(obs.yaws):
-        return np.zeros(n, np.bool_)
-    moving = ~np.asarray(obs.is_static, dtype=np.bool_)
+    leg reach) and the margin. ``boxes``: the frame's, as :func:`_boxes_now` gives them."""
+    centres, sizes, _, _, moving = boxes
     if not moving.any():
-        return np.zeros(n, np.bool_)
-    centres, _ = obs.poses_at(state.t)
+        return np.zeros(state.pelvis.shape[0], np.bool_)
     centres = centres[moving][:, [0, 2]]
-    radius = 0.5 * np.hypot(obs.sizes[moving, 0], obs.sizes[moving, 2])
+    radius = 0.5 * np.hypot(sizes[moving, 0], sizes[moving, 2])
     span = model.rest_radius + model.config.search_radius_m + float(np.max(model.reach))
     reach = radius + span + model.lod.moving_box_margin_m  # (B,)
     d = np.hypot(state.pelvis[:, None, 0] - centres[None, :, 0], state.pelvis[:, None, 2] - centres[None, :, 1])
@@ -1575,7 +1571,7 @@ def step(model: CrowdModel, state: CrowdState) -> dict[str, float]:
     t3 = clock()
     hips = hips_world(model, state)
     kinds = stage_requests(model, state, enter, boxes, hips, frequency)
-    budgets = character_budgets(model, state)
+    budgets = character_budgets(model, state, boxes)
     t4 = clock()
     chars = np.unique(np.nonzero(kinds)[0])
     if chars.size:
