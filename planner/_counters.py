@@ -51,14 +51,20 @@ def rendered_joints(model, state) -> np.ndarray:
     """(C, L, S + 2, 3) joint positions as drawn: forward kinematics of the IK angles, the hip
     first and the foot last; for characters whose IK is off, a straight hip -> planned foot leg."""
     from planner._crowd import hips_world
-    from planner._ik import body_rotation, forward_legs
+    from planner._ik import body_rotation
+    from planner._kernels_ik import forward_kinematics_batch
 
     c, l = state.in_stance.shape
     legs = model.leg_static
     hips = hips_world(model, state)
     rotations = np.repeat(body_rotation(state.heading, state.pitch, state.roll)[:, None], l, axis=1)
-    joints = forward_legs(hips.reshape(-1, 3), rotations.reshape(-1, 3, 3), np.tile(legs.rest_azimuths, c),
-                          np.tile(legs.segment_lengths, (c, 1)), state.angles.reshape(c * l, -1))
+    # The kernel itself (the runtime's own arrays, checked when the crowd was built): the checked
+    # forward_legs costs 3 ms a frame for 1000 spiders, and the controller calls this every frame.
+    joints = np.empty((c * l, legs.segment_lengths.shape[1] + 2, 3))
+    forward_kinematics_batch(np.ascontiguousarray(hips.reshape(-1, 3)), rotations.reshape(-1, 3, 3),
+                             np.tile(legs.rest_azimuths, c), np.tile(legs.plane_rolls, c),
+                             np.tile(legs.segment_lengths, (c, 1)), np.ascontiguousarray(state.angles.reshape(c * l, -1)),
+                             joints)
     joints = joints.reshape(c, l, -1, 3)[:, :, 1:]  # rows 0 and 1 are both the hip
     off = ~state.ik_on
     if off.any():

@@ -40,9 +40,11 @@ import numpy as np
 
 from planner._batch import FootBatch, plan_batch
 from planner._kernels_body import pelvis_from_hulls
+from planner._counters import rendered_joints
 from planner._kernels_controller import (
     advance_swings,
     count_forbidden_landings,
+    stance_legs_crossing,
     stance_threatened,
     swings_invalidated,
 )
@@ -712,7 +714,8 @@ def _solve_feet(model: CrowdModel, state: CrowdState, cs, ls, hips, iterations: 
     state.counters["ik_two_bone_legs" if two_bone else "ik_ccd_legs"] += int(cs.size)
     # The body poses as (yaw, pitch, roll): rotations built from angles need no orthonormality check.
     pose = np.column_stack([state.heading[cs], state.pitch[cs], state.roll[cs]])
-    return solve_legs_trusted(hips, pose, legs.rest_azimuths[ls], legs.segment_lengths[ls], legs.limits[ls],
+    return solve_legs_trusted(hips, pose, legs.rest_azimuths[ls], legs.plane_rolls[ls], legs.segment_lengths[ls],
+                              legs.limits[ls],
                               np.broadcast_to(legs.azimuth_limits, legs.rest_azimuths.shape)[ls],
                               state.feet[cs, ls], state.angles[cs, ls], iterations, restarts, two_bone=two_bone)
 
@@ -792,6 +795,10 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, fre
     # waiting for its sector, with the body slow and the needle slower, would freeze the walk.
     goal = np.minimum(state.desired_speed, state.speed_limit)[:, None]
     far |= cannot_follow | (stance_room(model, state) <= 0.0) | (leg_speed_caps(model, state) < 0.5 * goal)
+    # A stance foot the body turned across another leg steps (its own side again).
+    crossing = np.empty(state.in_stance.shape, dtype=np.bool_)
+    stance_legs_crossing(np.ascontiguousarray(rendered_joints(model, state)), state.in_stance, crossing)
+    far |= crossing
     centres, sizes, yaws, forbidden, moving = boxes
     threatened = np.zeros(state.in_stance.shape, dtype=np.bool_)
     invalid = np.zeros(state.in_stance.shape, dtype=np.bool_)

@@ -33,7 +33,16 @@ from planner._kernels_ik import (
 DEFAULT_AZIMUTH_LIMIT = 1.2
 """Default limit (rad) of the leg-plane azimuth joint: |azimuth| <= 1.2."""
 UPRIGHT_LEG_OFFSET = 0.25
-"""A leg whose rest foot is closer to under its hip than this fraction of its reach gets a free azimuth."""
+"""A leg whose rest foot is closer to under its hip than this fraction of its reach is upright: its
+azimuth is free, or, beside the body, its plane joint is an abduction (:data:`SIDED_HIP_OFFSET`)."""
+SIDED_HIP_OFFSET = 0.05
+"""An upright leg whose hip is off the body's midline by more than this fraction of its reach has an
+abduction (the plane rolls about the body's forward axis, ``CreatureLegs.plane_rolls``) instead of an
+azimuth joint: a foot passing beside its hip would turn a vertical leg plane half a circle, and a plane
+turned under the body folds the knee across the other legs."""
+ABDUCTION_LIMIT = 0.75
+"""Limit (rad) of an upright leg's abduction joint: the foot up to about a third of its depth to
+either side of the hip's fore-aft line."""
 DEFAULT_MAX_ITERATIONS = 32
 """Default sweep budget per leg (all descents together)."""
 DEFAULT_TOLERANCE = 1e-4
@@ -79,7 +88,9 @@ class CreatureLegs:
     rest_azimuths:   (L,) direction from hip to rest foot (rad, from forward towards left).
     segment_lengths: (L, S) m.
     limits:          (L, S, 2) hinge (min, max), rad (README convention).
-    azimuth_limits:  (L,) limit of the azimuth joint, rad.
+    azimuth_limits:  (L,) limit of the plane joint (azimuth or abduction), rad.
+    plane_rolls:     (L,) bool: the plane joint is an abduction (it rolls the leg plane about its
+                     outward direction, forward for these legs; :mod:`planner._kernels_ik`).
     """
 
     hips: np.ndarray
@@ -87,6 +98,7 @@ class CreatureLegs:
     segment_lengths: np.ndarray
     limits: np.ndarray
     azimuth_limits: np.ndarray
+    plane_rolls: np.ndarray
 
     @property
     def n_legs(self) -> int:
@@ -160,6 +172,16 @@ def _count(name: str, value) -> int:
     return int(value)
 
 
+def _plane_rolls(plane_rolls, n: int) -> np.ndarray:
+    """(n,) bool from None (no leg rolls) or an array of n booleans."""
+    if plane_rolls is None:
+        return np.zeros(n, dtype=np.bool_)
+    rolls = np.asarray(plane_rolls)
+    if rolls.shape != (n,) or rolls.dtype != np.bool_:
+        raise ValueError(f"plane_rolls: expected ({n},) booleans, got {rolls.dtype} {rolls.shape}")
+    return np.ascontiguousarray(rolls)
+
+
 def _leg_statics(rest_azimuths, segment_lengths, limits, azimuth_limits):
     lengths = _array("segment_lengths", segment_lengths, (None, None), MAX_COORDINATE)
     n, s = lengths.shape
@@ -184,7 +206,7 @@ def _leg_statics(rest_azimuths, segment_lengths, limits, azimuth_limits):
 def solve_legs(hips, body_rotations, rest_azimuths, segment_lengths, limits, azimuth_limits, targets,
                warm_start=None, max_iterations: int = DEFAULT_MAX_ITERATIONS, tolerance: float = DEFAULT_TOLERANCE,
                parallel: bool = True, restarts: int = DEFAULT_RESTARTS, pair_steps: bool = True,
-               two_bone: bool = False) -> IKResult:
+               two_bone: bool = False, plane_rolls=None) -> IKResult:
     """CCD inverse kinematics of B legs with S segments, in one kernel call.
 
     hips:            (B, 3) world hip positions (m).
@@ -206,6 +228,8 @@ def solve_legs(hips, body_rotations, rest_azimuths, segment_lengths, limits, azi
                      the azimuth and two hinges in closed form, one CCD sweep only where they
                      cannot reach (:func:`planner._kernels_ik.solve_legs_two_bone_serial`);
                      ``max_iterations``, ``restarts`` and ``pair_steps`` are not used.
+    plane_rolls:     (B,) bool, the plane joint is an abduction (``CreatureLegs.plane_rolls``);
+                     None: every leg has an azimuth joint.
 
     Never raises for an unreachable or degenerate target: the residual says how far the foot
     stays. Raises ValueError naming the offending argument for bad shapes or values.
@@ -227,25 +251,25 @@ def solve_legs(hips, body_rotations, rest_azimuths, segment_lengths, limits, azi
         raise ValueError(f"tolerance: expected a finite number >= 0, got {tolerance!r}")
     if two_bone and cold:
         raise ValueError("warm_start: the two-bone solve starts from a pose (got None)")
-    return _solve(hips, rotations, rest, lengths, lim, az, targets, warm, cold, max_iterations, restarts, tol,
-                  parallel, bool(pair_steps), two_bone)
+    return _solve(hips, rotations, rest, _plane_rolls(plane_rolls, n), lengths, lim, az, targets, warm, cold,
+                  max_iterations, restarts, tol, parallel, bool(pair_steps), two_bone)
 
 
-def solve_legs_trusted(hips, body_angles, rest_azimuths, segment_lengths, limits, azimuth_limits, targets,
-                       warm_start, max_iterations: int, restarts: int, two_bone: bool = False) -> IKResult:
+def solve_legs_trusted(hips, body_angles, rest_azimuths, plane_rolls, segment_lengths, limits, azimuth_limits,
+                       targets, warm_start, max_iterations: int, restarts: int, two_bone: bool = False) -> IKResult:
     """:func:`solve_legs` (parallel, pair steps, default tolerance, warm started) without checking its
     arguments: for the runtime's own arrays, checked once when the crowd was built (the checks cost
     about 0.1 ms a call, a few calls a frame). ``body_angles`` (B, 3) are (yaw, pitch, roll) and
     ``azimuth_limits`` is (B,); every array must already be float64."""
     rotations = body_rotation(body_angles[:, 0], body_angles[:, 1], body_angles[:, 2])
     c = np.ascontiguousarray
-    return _solve(c(hips), rotations, c(rest_azimuths), c(segment_lengths), c(limits), c(azimuth_limits),
+    return _solve(c(hips), rotations, c(rest_azimuths), c(plane_rolls), c(segment_lengths), c(limits), c(azimuth_limits),
                   c(targets), np.array(warm_start, dtype=np.float64, order="C"), False, int(max_iterations),
                   int(restarts), DEFAULT_TOLERANCE, True, True, two_bone)
 
 
-def _solve(hips, rotations, rest, lengths, lim, az, targets, warm, cold, max_iterations, restarts, tol, parallel,
-           pair_steps, two_bone) -> IKResult:
+def _solve(hips, rotations, rest, rolls, lengths, lim, az, targets, warm, cold, max_iterations, restarts, tol,
+           parallel, pair_steps, two_bone) -> IKResult:
     n, s = lengths.shape
     angles = np.empty((n, s + 1))
     residual = np.empty(n)
@@ -253,19 +277,19 @@ def _solve(hips, rotations, rest, lengths, lim, az, targets, warm, cold, max_ite
     joints = np.empty((n, s + 2, 3))
     if two_bone:
         kernel = solve_legs_two_bone_parallel if parallel else solve_legs_two_bone_serial
-        kernel(hips, rotations, rest, lengths, lim, az, targets, warm, tol, angles, residual, iterations, joints)
+        kernel(hips, rotations, rest, rolls, lengths, lim, az, targets, warm, tol, angles, residual, iterations, joints)
     else:
         kernel = solve_legs_parallel if parallel else solve_legs_serial
-        kernel(hips, rotations, rest, lengths, lim, az, targets, warm, cold, restarts, pair_steps,
+        kernel(hips, rotations, rest, rolls, lengths, lim, az, targets, warm, cold, restarts, pair_steps,
                max_iterations, tol, angles, residual, iterations, joints)
     return IKResult(angles=angles, residual=residual, iterations=iterations, converged=residual < tol,
                     joints=joints)
 
 
-def forward_legs(hips, body_rotations, rest_azimuths, segment_lengths, angles) -> np.ndarray:
+def forward_legs(hips, body_rotations, rest_azimuths, segment_lengths, angles, plane_rolls=None) -> np.ndarray:
     """(B, S + 2, 3) joint positions (rows as :attr:`IKResult.joints`) of B legs at ``angles`` (B, S + 1).
 
-    The angles are used as given (no limits applied).
+    The angles are used as given (no limits applied); ``plane_rolls`` as :func:`solve_legs`.
     """
     lengths = _array("segment_lengths", segment_lengths, (None, None), MAX_COORDINATE)
     n, s = lengths.shape
@@ -274,7 +298,7 @@ def forward_legs(hips, body_rotations, rest_azimuths, segment_lengths, angles) -
     rotations = _rotations("body_rotations", body_rotations, n)
     angles = _array("angles", angles, (n, s + 1))
     joints = np.empty((n, s + 2, 3))
-    forward_kinematics_batch(hips, rotations, rest, lengths, angles, joints)
+    forward_kinematics_batch(hips, rotations, rest, _plane_rolls(plane_rolls, n), lengths, angles, joints)
     return joints
 
 
@@ -303,7 +327,10 @@ def legs_of(creature, azimuth_limit: float = DEFAULT_AZIMUTH_LIMIT) -> CreatureL
     """Per-leg static arrays of a :class:`scenarios.Creature` (body frame).
 
     Rest azimuths follow :attr:`Creature.foot_directions` (hip to rest foot; a rest foot
-    straight below its hip points forward: azimuth 0).
+    straight below its hip points forward: azimuth 0). An upright leg (rest foot near under its
+    hip, :data:`UPRIGHT_LEG_OFFSET`) beside the midline (:data:`SIDED_HIP_OFFSET`) gets an
+    abduction joint within :data:`ABDUCTION_LIMIT` and a forward-facing plane; one on the
+    midline a free azimuth.
     """
     try:
         limit = float(azimuth_limit)
@@ -315,13 +342,17 @@ def legs_of(creature, azimuth_limit: float = DEFAULT_AZIMUTH_LIMIT) -> CreatureL
     # A leg whose rest foot stands (nearly) under its hip has no meaningful rest azimuth: the
     # foot passes on every side of the hip during a stride, so its azimuth is free.
     offset = np.hypot(creature.rest_feet[:, 0] - creature.hips[:, 0], creature.rest_feet[:, 1] - creature.hips[:, 2])
-    upright = offset < UPRIGHT_LEG_OFFSET * np.asarray(creature.leg_reach, dtype=np.float64)
+    reach = np.asarray(creature.leg_reach, dtype=np.float64)
+    upright = offset < UPRIGHT_LEG_OFFSET * reach
+    rolls = upright & (np.abs(creature.hips[:, 2]) > SIDED_HIP_OFFSET * reach)
     return CreatureLegs(
         hips=np.array(creature.hips, dtype=np.float64),
-        rest_azimuths=np.arctan2(directions[:, 1], directions[:, 0]),
+        # an abducting leg's plane faces forward (its knee bends in the body's fore-aft plane)
+        rest_azimuths=np.where(rolls, 0.0, np.arctan2(directions[:, 1], directions[:, 0])),
         segment_lengths=np.array(creature.segment_lengths, dtype=np.float64),
         limits=np.array(creature.joint_limits, dtype=np.float64),
-        azimuth_limits=np.where(upright, np.pi, limit),
+        azimuth_limits=np.where(rolls, ABDUCTION_LIMIT, np.where(upright, np.pi, limit)),
+        plane_rolls=rolls,
     )
 
 
@@ -336,13 +367,13 @@ def rest_pose_angles(creature, azimuth_limit: float = DEFAULT_AZIMUTH_LIMIT) -> 
 
     For warm starts. Solved by CCD in the body frame (identity rotation) from a cold start to
     1e-9 m, with the azimuth held within ``azimuth_limit`` even for legs whose azimuth is free
-    (so the rest pose is the canonical one); every built-in creature's rest pose is reachable within its limits, and its
-    azimuths come out 0 (up to round-off).
+    (so the rest pose is the canonical one); every built-in creature's rest pose is reachable within
+    its limits, and its azimuths come out 0 (up to round-off); an abducting leg's plane rolls
+    through its rest foot.
     """
     legs = legs_of(creature, azimuth_limit)
     n = legs.n_legs
     result = solve_legs(legs.hips, np.broadcast_to(np.eye(3), (n, 3, 3)), legs.rest_azimuths, legs.segment_lengths,
                         legs.limits, np.minimum(legs.azimuth_limits, azimuth_limit), rest_feet_body(creature),
-                        max_iterations=64,
-                        tolerance=1e-9, parallel=False)
+                        max_iterations=64, tolerance=1e-9, parallel=False, plane_rolls=legs.plane_rolls)
     return result.angles

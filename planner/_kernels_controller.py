@@ -148,29 +148,67 @@ def count_forbidden_landings(landed, feet, foot_hx, foot_hz, foot_yaws, box_cent
     return n
 
 
+@nb.njit(cache=True, inline="always")
+def _bbox_apart(joints, c, i, j):
+    """The ground bounding boxes of polylines ``joints[c, i]`` and ``joints[c, j]`` do not meet."""
+    ix0 = ix1 = joints[c, i, 0, 0]
+    iz0 = iz1 = joints[c, i, 0, 2]
+    jx0 = jx1 = joints[c, j, 0, 0]
+    jz0 = jz1 = joints[c, j, 0, 2]
+    for a in range(1, joints.shape[2]):
+        ix0 = min(ix0, joints[c, i, a, 0])
+        ix1 = max(ix1, joints[c, i, a, 0])
+        iz0 = min(iz0, joints[c, i, a, 2])
+        iz1 = max(iz1, joints[c, i, a, 2])
+        jx0 = min(jx0, joints[c, j, a, 0])
+        jx1 = max(jx1, joints[c, j, a, 0])
+        jz0 = min(jz0, joints[c, j, a, 2])
+        jz1 = max(jz1, joints[c, j, a, 2])
+    return ix1 < jx0 or jx1 < ix0 or iz1 < jz0 or jz1 < iz0
+
+
+@nb.njit(cache=True)
+def polylines_cross(joints, c, i, j):
+    """Leg i's ground projection (the polyline ``joints[c, i]``, P points, hip first) crosses leg j's:
+    some segment pair intersects properly (a crossing at a shared hip does not count)."""
+    n_points = joints.shape[2]
+    # bounding boxes first: most leg pairs are apart
+    if _bbox_apart(joints, c, i, j):
+        return False
+    for a in range(n_points - 1):
+        for b in range(n_points - 1):
+            if segments_cross(joints[c, i, a, 0], joints[c, i, a, 2], joints[c, i, a + 1, 0], joints[c, i, a + 1, 2],
+                              joints[c, j, b, 0], joints[c, j, b, 2], joints[c, j, b + 1, 0], joints[c, j, b + 1, 2]):
+                return True
+    return False
+
+
 @nb.njit(cache=True, parallel=True)
 def count_polyline_crossings(joints, out):
-    """Per character, pairs of legs whose rendered ground projections cross: leg i's polyline
-    (``joints[c, i]``, P points, hip first) against leg j's, every segment pair (a crossing at a
-    shared hip does not count: proper intersections only)."""
-    n_chars, n_legs, n_points, _ = joints.shape
+    """Per character, pairs of legs whose rendered ground projections cross (:func:`polylines_cross`)."""
+    n_chars, n_legs, _, _ = joints.shape
     for c in nb.prange(n_chars):
         n = 0
         for i in range(n_legs):
             for j in range(i + 1, n_legs):
-                crossed = False
-                for a in range(n_points - 1):
-                    if crossed:
-                        break
-                    for b in range(n_points - 1):
-                        if segments_cross(joints[c, i, a, 0], joints[c, i, a, 2], joints[c, i, a + 1, 0],
-                                          joints[c, i, a + 1, 2], joints[c, j, b, 0], joints[c, j, b, 2],
-                                          joints[c, j, b + 1, 0], joints[c, j, b + 1, 2]):
-                            crossed = True
-                            break
-                if crossed:
+                if polylines_cross(joints, c, i, j):
                     n += 1
         out[c] = n
+
+
+@nb.njit(cache=True, parallel=True)
+def stance_legs_crossing(joints, in_stance, out):
+    """Per character and leg, a stance leg whose rendered ground projection crosses another leg's
+    (:func:`polylines_cross`): a body turning over its stance feet carries them across its other legs."""
+    n_chars, n_legs, _, _ = joints.shape
+    for c in nb.prange(n_chars):
+        for i in range(n_legs):
+            out[c, i] = False
+        for i in range(n_legs):
+            for j in range(i + 1, n_legs):
+                if (in_stance[c, i] or in_stance[c, j]) and polylines_cross(joints, c, i, j):
+                    out[c, i] = out[c, i] or in_stance[c, i]
+                    out[c, j] = out[c, j] or in_stance[c, j]
 
 
 @nb.njit(cache=True, parallel=True)

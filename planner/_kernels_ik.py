@@ -39,6 +39,16 @@ pitch_{S-1}]``:
   direction from the hip to the rest foot, measured like a heading: from
   forward towards left). World outward ``u = R @ (cos b, 0, sin b)``, world
   up of the plane ``w = R[:, 1]``. Limits ``|q[0]| <= azimuth_limit``.
+* a leg with ``plane_rolls`` (an upright leg beside the body: the quadruped's)
+  has an abduction joint instead: its plane keeps the outward direction
+  ``(cos a, 0, sin a)`` (``a = rest_azimuth``, forward for an upright leg) and
+  rolls about it by ``q[0]``: plane up ``w = R @ (cos q0 (0, 1, 0) + sin q0 p)``
+  with ``p = (-sin a, 0, cos a)``, the horizontal left of the outward
+  direction (q0 > 0 swings the foot to the right of its outward direction).
+  A foot passing under its hip needs no turn of the plane (a vertical plane
+  through hip and foot turns half a circle as the foot passes beside the hip,
+  and a plane turned under the body folds the knee across the other legs).
+  Limits ``|q[0]| <= azimuth_limit`` as well.
 * hinge j sits at the proximal end of segment j, axis normal to the leg plane
   (README convention): ``pitch_0`` is segment 0's angle below the outward
   horizontal, ``pitch_j`` (j > 0) the bend of segment j relative to segment
@@ -74,7 +84,9 @@ step is an exact minimiser of the foot-target distance over its joint(s):
   the target. ``pair_steps=False`` gives plain CCD.
 * the azimuth, analytically: point the leg plane at the target (away from it
   when the foot is behind the hip, its in-plane outward coordinate < 0),
-  clamped to +-azimuth_limit.
+  clamped to +-azimuth_limit; a rolling plane joint rolls the plane through
+  the target (the foot on the side of the hip it is on, below it as a rule),
+  clamped the same way.
 
 A step is skipped when undefined (the foot or the target on the joint's
 rotation axis: a target at the hip, a degenerate leg plane), so no NaN ever
@@ -103,14 +115,9 @@ the tolerance (no jump to another pose for nothing); the rest of the budget
 polishes the kept pose when its descent was cut short. ``max_iterations``
 bounds the sweeps of all descents together. Unreachable targets thus end at a
 closest reachable pose found, with the distance reported as the residual
-(never NaN, never an exception). An upright leg (free azimuth, its rest foot beside its hip)
-whose reaching pose turns its leg plane under the body (:func:`_knee_inward`: the knee folds
-across the other legs) goes on restarting while restarts remain, and a pose that reaches the
-foot with the plane on the leg's own side replaces it (every frame while the knee stays under the
-body: 100 quadrupeds' IK costs 1.2 ms a frame instead of 0.56; searching only when a pose first turns
-inward cost 0.8 ms but left 4 times the crossings on hills); once a pose reaches the foot, nothing
-else replaces it (not a pose closer by round-off: the same legs posed in a rotated frame get the
-same angles). Restarts trade continuity for reach: a warm
+(never NaN, never an exception). Once a pose reaches the foot, nothing else
+replaces it (not a pose closer by round-off: the same legs posed in a rotated
+frame get the same angles). Restarts trade continuity for reach: a warm
 start whose target left its reachable branch (e.g. past the azimuth limit) may
 jump to another pose that reaches it; ``restarts=0`` never leaves the branch.
 """
@@ -175,8 +182,17 @@ def _wrap_pi(x):
 
 
 @nb.njit(cache=True)
-def _in_plane_target(df, du, dl, beta):
-    """Target (outward, up, normal) coordinates in the leg plane of azimuth ``beta``."""
+def _in_plane_target(df, du, dl, alpha, q_plane, rolls):
+    """Target (outward, up, normal) coordinates in the leg plane at plane angle ``q_plane``
+    (rest azimuth ``alpha``; ``rolls``: the plane rolls about its outward axis, module docstring)."""
+    if rolls:
+        ca = math.cos(alpha)
+        sa = math.sin(alpha)
+        side = -df * sa + dl * ca
+        cr = math.cos(q_plane)
+        sr = math.sin(q_plane)
+        return df * ca + dl * sa, du * cr + side * sr, -du * sr + side * cr
+    beta = alpha + q_plane
     cb = math.cos(beta)
     sb = math.sin(beta)
     return df * cb + dl * sb, du, -df * sb + dl * cb
@@ -237,8 +253,17 @@ def _grid_angle(lo, hi, k, levels):
 
 
 @nb.njit(cache=True)
-def _azimuth_for(fx, q_az, df, dl, alpha, azimuth_limit):
-    """Exact single-joint azimuth step: the leg plane towards the target (away if fx < 0), clamped."""
+def _azimuth_for(fx, fy, q_az, df, du, dl, alpha, azimuth_limit, rolls):
+    """Exact single-joint step of the plane joint, clamped: the leg plane towards the target (away if
+    fx < 0); a rolling plane through the target, the foot on its side of the hip (below if fy < 0)."""
+    if rolls:
+        side = -df * math.sin(alpha) + dl * math.cos(alpha)
+        if math.hypot(du, side) < EPS or abs(fy) < EPS:
+            return q_az
+        want = math.atan2(-side, -du)
+        if fy > 0.0:
+            want += math.pi
+        return nearest_in_limits(q_az + _wrap_pi(want - q_az), -azimuth_limit, azimuth_limit)
     horizontal = math.hypot(df, dl)
     if horizontal < EPS or abs(fx) < EPS:
         return q_az
@@ -259,7 +284,7 @@ def seed_levels(n_seg):
 
 
 @nb.njit(cache=True)
-def _next_seed(b, lengths, limits, azimuth_limits, df, du, dl, alpha, levels, after_dist, after_code):
+def _next_seed(b, lengths, limits, azimuth_limits, df, du, dl, alpha, rolls, levels, after_dist, after_code):
     """The grid pose after (``after_dist``, ``after_code``) in (squared distance, code) order.
 
     Grid: ``levels ** S`` hinge poses, each with its analytic azimuth. Returns
@@ -281,8 +306,8 @@ def _next_seed(b, lengths, limits, azimuth_limits, df, du, dl, alpha, levels, af
             c //= levels
             x += lengths[b, j] * math.cos(phi)
             y -= lengths[b, j] * math.sin(phi)
-        az = _azimuth_for(x, 0.0, df, dl, alpha, azimuth_limits[b])
-        tx, ty, tn = _in_plane_target(df, du, dl, alpha + az)
+        az = _azimuth_for(x, y, 0.0, df, du, dl, alpha, azimuth_limits[b], rolls)
+        tx, ty, tn = _in_plane_target(df, du, dl, alpha, az, rolls)
         d = (x - tx) ** 2 + (y - ty) ** 2 + tn * tn
         if (d > after_dist or (d == after_dist and code > after_code)) and d < best_dist:
             best_dist = d
@@ -291,14 +316,14 @@ def _next_seed(b, lengths, limits, azimuth_limits, df, du, dl, alpha, levels, af
 
 
 @nb.njit(cache=True)
-def _set_grid_pose(b, code, levels, lengths, limits, azimuth_limits, df, dl, alpha, q):
+def _set_grid_pose(b, code, levels, lengths, limits, azimuth_limits, df, du, dl, alpha, rolls, q):
     """q[b] = grid pose ``code`` with its analytic azimuth."""
     c = code
     for j in range(lengths.shape[1]):
         q[b, j + 1] = _grid_angle(limits[b, j, 0], limits[b, j, 1], c % levels, levels)
         c //= levels
-    fx, _, _ = _planar_point(lengths, q, b, lengths.shape[1])
-    q[b, 0] = _azimuth_for(fx, 0.0, df, dl, alpha, azimuth_limits[b])
+    fx, fy, _ = _planar_point(lengths, q, b, lengths.shape[1])
+    q[b, 0] = _azimuth_for(fx, fy, 0.0, df, du, dl, alpha, azimuth_limits[b], rolls)
 
 
 @nb.njit(cache=True)
@@ -408,7 +433,7 @@ def _pair_step(b, i, j, lengths, limits, q, fx, fy, tx, ty, mirror, chain):
 
 
 @nb.njit(cache=True)
-def _descend(b, lengths, limits, azimuth_limits, df, du, dl, alpha, pair_steps, mirror, budget, tolerance,
+def _descend(b, lengths, limits, azimuth_limits, df, du, dl, alpha, rolls, pair_steps, mirror, budget, tolerance,
              stop_on_stall, q, chain):
     """CCD sweeps on q[b] from its current pose. Returns (residual, sweeps used, stopped by a stall).
 
@@ -423,8 +448,8 @@ def _descend(b, lengths, limits, azimuth_limits, df, du, dl, alpha, pair_steps, 
     # The leg plane first: a warm-started leg whose target moved sideways (the body moved)
     # then solves in the right plane, and can stop within its first sweep.
     if budget > 0:
-        q[b, 0] = _azimuth_for(fx, q[b, 0], df, dl, alpha, azimuth_limits[b])
-    tx, ty, tn = _in_plane_target(df, du, dl, alpha + q[b, 0])
+        q[b, 0] = _azimuth_for(fx, fy, q[b, 0], df, du, dl, alpha, azimuth_limits[b], rolls)
+    tx, ty, tn = _in_plane_target(df, du, dl, alpha, q[b, 0], rolls)
     residual = math.sqrt((fx - tx) ** 2 + (fy - ty) ** 2 + tn * tn)
     used = 0
     while residual >= tolerance and used < budget:
@@ -453,11 +478,11 @@ def _descend(b, lengths, limits, azimuth_limits, df, du, dl, alpha, pair_steps, 
         if reached:
             return math.sqrt((fx - tx) ** 2 + (fy - ty) ** 2 + tn2), used, False
         # azimuth: analytic
-        new = _azimuth_for(fx, q[b, 0], df, dl, alpha, azimuth_limits[b])
+        new = _azimuth_for(fx, fy, q[b, 0], df, du, dl, alpha, azimuth_limits[b], rolls)
         if new != q[b, 0]:
             q[b, 0] = new
             changed = True
-            tx, ty, tn = _in_plane_target(df, du, dl, alpha + new)
+            tx, ty, tn = _in_plane_target(df, du, dl, alpha, new, rolls)
         residual = math.sqrt((fx - tx) ** 2 + (fy - ty) ** 2 + tn * tn)
         if not changed:
             break
@@ -486,30 +511,15 @@ def _warm_into_limits(b, q, warm, limits, azimuth_limits, n_seg):
         q[b, j + 1] = nearest_in_limits(warm[b, j + 1], limits[b, j, 0], limits[b, j, 1])
 
 
-INWARD_SIN = 0.25
-"""An upright leg's plane pointing under the body (its outward direction's lateral component below
--0.25 on the leg's side: more than about 15 degrees inward of the fore-aft line) folds the knee across
-the other legs. (0.5 left the quadruped 3-10 crossings per 4 runs on hills, 0.25 0-3; 0 no fewer.)"""
-
-
-@nb.njit(cache=True, inline="always")
-def _knee_inward(alpha, q_az, azimuth_limit):
-    """An upright leg (free azimuth, its rest foot beside its hip) whose leg plane, and so its knee,
-    points under the body (:data:`INWARD_SIN`). Other legs: never."""
-    side = math.sin(alpha)
-    if azimuth_limit < math.pi or abs(side) <= 0.5:
-        return False
-    return math.sin(alpha + q_az) * math.copysign(1.0, side) < -INWARD_SIN
-
-
 @nb.njit(cache=True)
-def _solve_one(b, hips, rotations, rest_azimuths, lengths, limits, azimuth_limits, targets, warm, cold, restarts,
-               pair_steps, max_iterations, tolerance, out_angles, out_residual, out_iterations, out_joints):
+def _solve_one(b, hips, rotations, rest_azimuths, plane_rolls, lengths, limits, azimuth_limits, targets, warm, cold,
+               restarts, pair_steps, max_iterations, tolerance, out_angles, out_residual, out_iterations, out_joints):
     """CCD with restarts for leg ``b`` (module docstring); writes row ``b`` of every output."""
     n_seg = lengths.shape[1]
     q = out_angles
     df, du, dl = _target_in_body(b, hips, rotations, targets)
     alpha = rest_azimuths[b]
+    rolls = plane_rolls[b]
 
     # warm start, brought into the limits (replaced by the nearest grid pose when cold)
     _warm_into_limits(b, q, warm, limits, azimuth_limits, n_seg)
@@ -528,25 +538,23 @@ def _solve_one(b, hips, rotations, rest_azimuths, lengths, limits, azimuth_limit
     attempt = 0  # restarts so far
     while True:
         if need_seed:
-            seed_dist, seed_code = _next_seed(b, lengths, limits, azimuth_limits, df, du, dl, alpha, levels,
+            seed_dist, seed_code = _next_seed(b, lengths, limits, azimuth_limits, df, du, dl, alpha, rolls, levels,
                                               seed_dist, seed_code)
             if seed_code < 0:
                 break
-            _set_grid_pose(b, seed_code, levels, lengths, limits, azimuth_limits, df, dl, alpha, q)
+            _set_grid_pose(b, seed_code, levels, lengths, limits, azimuth_limits, df, du, dl, alpha, rolls, q)
         # mirror solutions of the two-hinge steps only away from a warm start (continuity)
         seeded = need_seed or (polish and best_seeded)
-        residual, sweeps, stalled = _descend(b, lengths, limits, azimuth_limits, df, du, dl, alpha, pair_steps,
-                                             seeded, max_iterations - used, tolerance,
+        residual, sweeps, stalled = _descend(b, lengths, limits, azimuth_limits, df, du, dl, alpha, rolls,
+                                             pair_steps, seeded, max_iterations - used, tolerance,
                                              attempt < restarts and not polish, q, chain)
         used += sweeps
         # a restart must converge or beat the best by more than the tolerance: no jump to another
         # pose for nothing (the polish continues the best pose, it never ends worse)
         if have_best and best_residual < tolerance:
-            # Only an upright leg with its knee folded under the body (across the other legs) restarts
-            # once its foot is reached: a pose that reaches the foot as well with the knee on the leg's
-            # own side replaces it, and nothing else does (not a pose closer by round-off).
-            better = (residual < tolerance and _knee_inward(alpha, best[0], azimuth_limits[b])
-                      and not _knee_inward(alpha, q[b, 0], azimuth_limits[b]))
+            # Nothing replaces a pose that reaches its foot (not a pose closer by round-off: the same
+            # legs posed in a rotated frame must get the same angles).
+            better = False
         else:
             better = residual < best_residual and (residual < tolerance or residual < best_residual - tolerance)
         if not have_best or polish or better:
@@ -558,7 +566,7 @@ def _solve_one(b, hips, rotations, rest_azimuths, lengths, limits, azimuth_limit
                 best[k] = q[b, k]
         if polish or used >= max_iterations:
             break
-        if best_residual < tolerance and not (attempt < restarts and _knee_inward(alpha, best[0], azimuth_limits[b])):
+        if best_residual < tolerance:
             break
         if attempt < restarts:
             # stalled or stuck: restart from the next grid pose, nearest first
@@ -575,22 +583,35 @@ def _solve_one(b, hips, rotations, rest_azimuths, lengths, limits, azimuth_limit
         q[b, k] = best[k]
     out_residual[b] = best_residual
     out_iterations[b] = used
-    _joints_into(b, hips, rotations, rest_azimuths, lengths, q, out_joints)
+    _joints_into(b, hips, rotations, rest_azimuths, plane_rolls, lengths, q, out_joints)
 
 
 @nb.njit(cache=True)
-def _leg_points(hip, rotation, rest_azimuth, lengths, angles, out):
+def _leg_points(hip, rotation, rest_azimuth, rolls, lengths, angles, out):
     """World positions (S + 1, 3) into ``out``: hip, end of each segment (knees..., foot)."""
-    beta = rest_azimuth + angles[0]
-    cb = math.cos(beta)
-    sb = math.sin(beta)
-    # outward u = R (cos b, 0, sin b), plane up w = R[:, 1]
+    if rolls:
+        # outward u = R (cos a, 0, sin a); plane up w = R (cos q0 (0, 1, 0) + sin q0 (-sin a, 0, cos a))
+        cb = math.cos(rest_azimuth)
+        sb = math.sin(rest_azimuth)
+        cr = math.cos(angles[0])
+        sr = math.sin(angles[0])
+        wf = -sr * sb
+        wl = sr * cb
+        wx = rotation[0, 0] * wf + rotation[0, 1] * cr + rotation[0, 2] * wl
+        wy = rotation[1, 0] * wf + rotation[1, 1] * cr + rotation[1, 2] * wl
+        wz = rotation[2, 0] * wf + rotation[2, 1] * cr + rotation[2, 2] * wl
+    else:
+        beta = rest_azimuth + angles[0]
+        cb = math.cos(beta)
+        sb = math.sin(beta)
+        # plane up w = R[:, 1]
+        wx = rotation[0, 1]
+        wy = rotation[1, 1]
+        wz = rotation[2, 1]
+    # outward u = R (cos b, 0, sin b)
     ux = rotation[0, 0] * cb + rotation[0, 2] * sb
     uy = rotation[1, 0] * cb + rotation[1, 2] * sb
     uz = rotation[2, 0] * cb + rotation[2, 2] * sb
-    wx = rotation[0, 1]
-    wy = rotation[1, 1]
-    wz = rotation[2, 1]
     out[0, 0] = hip[0]
     out[0, 1] = hip[1]
     out[0, 2] = hip[2]
@@ -607,41 +628,46 @@ def _leg_points(hip, rotation, rest_azimuth, lengths, angles, out):
 
 
 @nb.njit(cache=True)
-def _joints_into(b, hips, rotations, rest_azimuths, lengths, angles, out_joints):
+def _joints_into(b, hips, rotations, rest_azimuths, plane_rolls, lengths, angles, out_joints):
     """``out_joints[b]`` (S + 2, 3): azimuth pivot (the hip), hinge 0 (the hip), knees..., foot."""
     for k in range(3):
         out_joints[b, 0, k] = hips[b, k]
-    _leg_points(hips[b], rotations[b], rest_azimuths[b], lengths[b], angles[b], out_joints[b, 1:])
+    _leg_points(hips[b], rotations[b], rest_azimuths[b], plane_rolls[b], lengths[b], angles[b], out_joints[b, 1:])
 
 
 @nb.njit(cache=True)
-def forward_kinematics(hip, rotation, rest_azimuth, lengths, angles):
+def forward_kinematics(hip, rotation, rest_azimuth, lengths, angles, rolls=False):
     """(S + 1, 3) world positions of one leg: hip, knees..., foot.
 
     ``hip`` (3,) world, ``rotation`` (3, 3) body rotation (module docstring),
     ``rest_azimuth`` (rad), ``lengths`` (S,), ``angles`` (S + 1,) = [azimuth,
-    pitch_0, ..., pitch_{S-1}], used as given (no limits here).
+    pitch_0, ..., pitch_{S-1}], used as given (no limits here); ``rolls``: the
+    plane joint is an abduction (module docstring).
     """
     out = np.empty((lengths.shape[0] + 1, 3), dtype=np.float64)
-    _leg_points(hip, rotation, rest_azimuth, lengths, angles, out)
+    _leg_points(hip, rotation, rest_azimuth, rolls, lengths, angles, out)
     return out
 
 
-@nb.njit(cache=True)
-def forward_kinematics_batch(hips, rotations, rest_azimuths, lengths, angles, out_joints):
-    """Joint positions (B, S + 2, 3) of B legs, rows as in :func:`solve_legs_serial`, in place."""
-    for b in range(hips.shape[0]):
-        _joints_into(b, hips, rotations, rest_azimuths, lengths, angles, out_joints)
+@nb.njit(cache=True, parallel=True)
+def forward_kinematics_batch(hips, rotations, rest_azimuths, plane_rolls, lengths, angles, out_joints):
+    """Joint positions (B, S + 2, 3) of B legs, rows as in :func:`solve_legs_serial`, in place
+    (legs spread over the cores: the controller draws every leg of the crowd every frame)."""
+    for i in nb.prange(hips.shape[0]):
+        b = np.int64(i)
+        _joints_into(b, hips, rotations, rest_azimuths, plane_rolls, lengths, angles, out_joints)
 
 
 @nb.njit(cache=True)
-def solve_legs_serial(hips, rotations, rest_azimuths, lengths, limits, azimuth_limits, targets, warm, cold, restarts,
-                      pair_steps, max_iterations, tolerance, out_angles, out_residual, out_iterations, out_joints):
+def solve_legs_serial(hips, rotations, rest_azimuths, plane_rolls, lengths, limits, azimuth_limits, targets, warm, cold,
+                      restarts, pair_steps, max_iterations, tolerance, out_angles, out_residual, out_iterations,
+                      out_joints):
     """CCD over B legs with S segments, one leg after the other (module docstring).
 
     Inputs (struct of arrays over legs, float64, C-contiguous; unchecked: the
     Python API validates): ``hips`` (B, 3) world; ``rotations`` (B, 3, 3) body
-    rotation of each leg's character; ``rest_azimuths`` (B,); ``lengths`` (B, S)
+    rotation of each leg's character; ``rest_azimuths`` (B,); ``plane_rolls`` (B,)
+    bool, the plane joint is an abduction (module docstring); ``lengths`` (B, S)
     > 0; ``limits`` (B, S, 2) hinge (min, max), min < max; ``azimuth_limits``
     (B,) >= 0; ``targets`` (B, 3) world; ``warm`` (B, S + 1) warm-start angles;
     ``cold`` (bool): ignore ``warm``, start from the nearest grid pose;
@@ -656,20 +682,20 @@ def solve_legs_serial(hips, rotations, rest_azimuths, lengths, limits, azimuth_l
     (rows 0 and 1 are both the hip), the foot last.
     """
     for b in range(hips.shape[0]):
-        _solve_one(b, hips, rotations, rest_azimuths, lengths, limits, azimuth_limits, targets, warm, cold,
-                   restarts, pair_steps, max_iterations, tolerance, out_angles, out_residual, out_iterations,
+        _solve_one(b, hips, rotations, rest_azimuths, plane_rolls, lengths, limits, azimuth_limits, targets, warm,
+                   cold, restarts, pair_steps, max_iterations, tolerance, out_angles, out_residual, out_iterations,
                    out_joints)
 
 
 @nb.njit(cache=True, parallel=True)
-def solve_legs_parallel(hips, rotations, rest_azimuths, lengths, limits, azimuth_limits, targets, warm, cold,
-                        restarts, pair_steps, max_iterations, tolerance, out_angles, out_residual, out_iterations,
+def solve_legs_parallel(hips, rotations, rest_azimuths, plane_rolls, lengths, limits, azimuth_limits, targets, warm,
+                        cold, restarts, pair_steps, max_iterations, tolerance, out_angles, out_residual, out_iterations,
                         out_joints):
     """Same as :func:`solve_legs_serial`, legs spread over the cores (bit-identical results)."""
     for i in nb.prange(hips.shape[0]):
         b = np.int64(i)  # prange indices are unsigned: keep the serial kernel's signature (one compilation)
-        _solve_one(b, hips, rotations, rest_azimuths, lengths, limits, azimuth_limits, targets, warm, cold,
-                   restarts, pair_steps, max_iterations, tolerance, out_angles, out_residual, out_iterations,
+        _solve_one(b, hips, rotations, rest_azimuths, plane_rolls, lengths, limits, azimuth_limits, targets, warm,
+                   cold, restarts, pair_steps, max_iterations, tolerance, out_angles, out_residual, out_iterations,
                    out_joints)
 
 
@@ -682,20 +708,21 @@ def two_bone_pair(n_seg):
 
 
 @nb.njit(cache=True)
-def _two_bone_one(b, hips, rotations, rest_azimuths, lengths, limits, azimuth_limits, targets, warm, tolerance,
-                  out_angles, out_residual, out_iterations, out_joints):
+def _two_bone_one(b, hips, rotations, rest_azimuths, plane_rolls, lengths, limits, azimuth_limits, targets, warm,
+                  tolerance, out_angles, out_residual, out_iterations, out_joints):
     """The analytic solve of leg ``b`` (:func:`solve_legs_two_bone_serial`); writes row ``b``."""
     n_seg = lengths.shape[1]
     q = out_angles
     df, du, dl = _target_in_body(b, hips, rotations, targets)
     alpha = rest_azimuths[b]
+    rolls = plane_rolls[b]
     _warm_into_limits(b, q, warm, limits, azimuth_limits, n_seg)
     chain = np.empty((n_seg + 1, N_CHAIN), dtype=np.float64)
     _chain_from(b, lengths, q, 0, chain)
     fx = chain[n_seg, CH_X]
     fy = chain[n_seg, CH_Y]
-    q[b, 0] = _azimuth_for(fx, q[b, 0], df, dl, alpha, azimuth_limits[b])
-    tx, ty, tn = _in_plane_target(df, du, dl, alpha + q[b, 0])
+    q[b, 0] = _azimuth_for(fx, fy, q[b, 0], df, du, dl, alpha, azimuth_limits[b], rolls)
+    tx, ty, tn = _in_plane_target(df, du, dl, alpha, q[b, 0], rolls)
     i, j = two_bone_pair(n_seg)
     _, fx, fy = _pair_step(b, i, j, lengths, limits, q, fx, fy, tx, ty, False, chain)
     residual = math.sqrt((fx - tx) ** 2 + (fy - ty) ** 2 + tn * tn)
@@ -703,17 +730,17 @@ def _two_bone_one(b, hips, rotations, rest_azimuths, lengths, limits, azimuth_li
     if residual >= tolerance:
         # the two bones alone cannot reach (a limit, a target beyond their span): one CCD sweep of
         # the whole leg from there, no restart (the pose stays on its branch)
-        residual, sweeps, _ = _descend(b, lengths, limits, azimuth_limits, df, du, dl, alpha, True, False, 1,
+        residual, sweeps, _ = _descend(b, lengths, limits, azimuth_limits, df, du, dl, alpha, rolls, True, False, 1,
                                        tolerance, False, q, chain)
         used += sweeps
     out_residual[b] = residual
     out_iterations[b] = used
-    _joints_into(b, hips, rotations, rest_azimuths, lengths, q, out_joints)
+    _joints_into(b, hips, rotations, rest_azimuths, plane_rolls, lengths, q, out_joints)
 
 
 @nb.njit(cache=True)
-def solve_legs_two_bone_serial(hips, rotations, rest_azimuths, lengths, limits, azimuth_limits, targets, warm,
-                               tolerance, out_angles, out_residual, out_iterations, out_joints):
+def solve_legs_two_bone_serial(hips, rotations, rest_azimuths, plane_rolls, lengths, limits, azimuth_limits, targets,
+                               warm, tolerance, out_angles, out_residual, out_iterations, out_joints):
     """The far characters' IK (level of detail): from the warm start, the azimuth and then the two
     hinges of :func:`two_bone_pair` in closed form (:func:`_pair_step`, the bend kept: no flip),
     the other hinges rigid; one CCD sweep of the whole leg only when that leaves the foot beyond
@@ -721,15 +748,15 @@ def solve_legs_two_bone_serial(hips, rotations, rest_azimuths, lengths, limits, 
     calls per leg instead of a CCD sweep's dozens. Arguments and outputs as
     :func:`solve_legs_serial` (warm starts only)."""
     for b in range(hips.shape[0]):
-        _two_bone_one(b, hips, rotations, rest_azimuths, lengths, limits, azimuth_limits, targets, warm, tolerance,
-                      out_angles, out_residual, out_iterations, out_joints)
+        _two_bone_one(b, hips, rotations, rest_azimuths, plane_rolls, lengths, limits, azimuth_limits, targets, warm,
+                      tolerance, out_angles, out_residual, out_iterations, out_joints)
 
 
 @nb.njit(cache=True, parallel=True)
-def solve_legs_two_bone_parallel(hips, rotations, rest_azimuths, lengths, limits, azimuth_limits, targets, warm,
-                                 tolerance, out_angles, out_residual, out_iterations, out_joints):
+def solve_legs_two_bone_parallel(hips, rotations, rest_azimuths, plane_rolls, lengths, limits, azimuth_limits,
+                                 targets, warm, tolerance, out_angles, out_residual, out_iterations, out_joints):
     """Same as :func:`solve_legs_two_bone_serial`, legs spread over the cores (bit-identical results)."""
     for i in nb.prange(hips.shape[0]):
         b = np.int64(i)
-        _two_bone_one(b, hips, rotations, rest_azimuths, lengths, limits, azimuth_limits, targets, warm, tolerance,
-                      out_angles, out_residual, out_iterations, out_joints)
+        _two_bone_one(b, hips, rotations, rest_azimuths, plane_rolls, lengths, limits, azimuth_limits, targets, warm,
+                      tolerance, out_angles, out_residual, out_iterations, out_joints)

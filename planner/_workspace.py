@@ -51,7 +51,7 @@ def _cached(kind: str, creature, rest_body, hips_body, legs, compute):
     few thousand IK solves), then shared by every crowd of that creature."""
     key = (kind, creature.name, float(creature.standing_height), np.asarray(creature.leg_reach).tobytes(),
            rest_body.tobytes(), hips_body.tobytes(), legs.segment_lengths.tobytes(), legs.limits.tobytes(),
-           legs.rest_azimuths.tobytes(), np.asarray(legs.azimuth_limits).tobytes())
+           legs.rest_azimuths.tobytes(), np.asarray(legs.azimuth_limits).tobytes(), legs.plane_rolls.tobytes())
     if key not in _CACHE:
         _CACHE[key] = compute()
     value = _CACHE[key]
@@ -92,7 +92,7 @@ def _reached(hips_body, legs, leg, targets) -> np.ndarray:
 
     result = solve_legs(hips_body[leg], np.broadcast_to(np.eye(3), (leg.size, 3, 3)), legs.rest_azimuths[leg],
                         legs.segment_lengths[leg], legs.limits[leg], legs.azimuth_limits[leg], targets,
-                        max_iterations=48, restarts=8, parallel=True)
+                        max_iterations=48, restarts=8, parallel=True, plane_rolls=legs.plane_rolls[leg])
     return result.residual < REACH_TOLERANCE
 
 

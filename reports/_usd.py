@@ -24,7 +24,8 @@ its forward kinematics puts every joint where :func:`planner._ik.forward_legs` p
   rotations (body x forward, y up, z left);
 * ``<leg>_hip`` (azimuth joint): translation = the hip (body frame), rotation
   R_y(-(rest_azimuth + azimuth)): its x axis is the leg plane's outward direction, z
-  the plane's normal;
+  the plane's normal; an abduction joint (``plane_rolls``): R_y(-rest_azimuth)
+  R_x(abduction), the plane rolled about its outward axis;
 * ``<leg>_hinge0 .. hinge{S-1}``: rotation R_z(-pitch_j) (positive pitch bends down),
   translation (length of the previous segment, 0, 0) (hinge 0 sits at the hip);
 * ``<leg>_tip``: the foot, (length of the last segment, 0, 0) along the last hinge's x.
@@ -152,7 +153,13 @@ def joint_local_transforms(creature, layout: SkeletonLayout, pelvis, orientation
     translations[..., 0, :] = pelvis
     for leg in range(legs.n_legs):
         hip, *hinges, tip = layout.leg_joints[leg]
-        rotations[..., hip, :] = _axis_quaternions(-(legs.rest_azimuths[leg] + angles[..., leg, 0]), 1)
+        if legs.plane_rolls[leg]:
+            # an abduction: the plane faces its rest azimuth and rolls about its outward (x) axis
+            facing = np.full(angles.shape[:-2], -legs.rest_azimuths[leg])
+            rotations[..., hip, :] = _quaternion_product(_axis_quaternions(facing, 1),
+                                                         _axis_quaternions(angles[..., leg, 0], 0))
+        else:
+            rotations[..., hip, :] = _axis_quaternions(-(legs.rest_azimuths[leg] + angles[..., leg, 0]), 1)
         translations[..., hip, :] = legs.hips[leg]
         for j, joint in enumerate(hinges):
             rotations[..., joint, :] = _axis_quaternions(-angles[..., leg, j + 1], 2)

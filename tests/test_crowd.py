@@ -29,13 +29,9 @@ def _raster(scenario, creature):
 
 
 # Found by the counters on the rendered pose (planner._counters) and not fixed yet; strict: when one
-# is fixed, its runs must pass. (A quadruped's knees crossed on hills, folded under the body by a leg
-# plane turned inward: fixed in the IK, planner._kernels_ik._knee_inward.)
-KNOWN_DEFECTS: dict[tuple[str, str], str] = {
-    ("quadruped", "stairs"): "open defect (issue 14): with crowds spawned a leg span apart, seed 8 (3 quadrupeds, "
-    "LOD zoomed) has one frame where a swinging hind leg's hock meets the other hind leg under the body (frame 30, "
-    "walking straight at 0.3 m/s); the legs have no abduction joint to keep them apart",
-}
+# is fixed, its runs must pass. (A quadruped's knees crossed on hills and stairs, folded under the body
+# by a leg plane turned inward: fixed by the abduction joint of upright legs, planner._ik.legs_of.)
+KNOWN_DEFECTS: dict[tuple[str, str], str] = {}
 
 
 @pytest.mark.parametrize("scenario_name", builtin_scenario_names())
@@ -387,3 +383,33 @@ def test_a_crowds_feet_keep_a_foots_room_from_each_other():
         counts[avoid] = simulate(model, state, 200).shared_foot_spots
     assert counts[True] == 0
     assert counts[False] > 0, "the run must bring feet of different characters together"
+
+
+def test_a_stance_leg_carried_across_another_leg_steps():
+    # Two neighbouring stance feet of a standing spider swapped (as a body turning over its feet
+    # carries them): their drawn legs cross, and the controller asks both to step now (kind 2, a
+    # forced step); with the feet back, neither.
+    from planner._crowd import _boxes_now, stage_ik, stage_requests
+
+    scenario, creature = load_scenario("flat"), load_creature("spider")
+    model, state = init_crowd(scenario, creature, load_gait(default_gait_name("spider"), creature), n_characters=1,
+                              seed=0, lod_mode="off")
+    boxes = _boxes_now(model, state.t)
+    frequency = np.ones(1)
+    quiet = np.zeros(state.in_stance.shape, np.bool_)
+
+    def forced():
+        state.wants_swing[:] = False
+        kinds = stage_requests(model, state, quiet, boxes, hips_world(model, state), frequency)
+        return kinds[0] == 2
+
+    state.in_stance[:] = True
+    before = forced()  # a character at rest, asked to walk: some feet step anyway
+    assert not before[:2].any()  # premise: not these two
+    state.feet[0, [0, 1]] = state.feet[0, [1, 0]]
+    stage_ik(model, state, np.ones(1, np.bool_))
+    assert np.all(state.residual[0, :2] < 1e-3)
+    assert forced()[:2].all()
+    state.feet[0, [0, 1]] = state.feet[0, [1, 0]]  # back: neither
+    stage_ik(model, state, np.ones(1, np.bool_))
+    assert not forced()[:2].any()

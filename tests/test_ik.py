@@ -9,6 +9,7 @@ import pytest
 from scipy.spatial import cKDTree
 
 from planner._ik import (
+    ABDUCTION_LIMIT,
     DEFAULT_AZIMUTH_LIMIT,
     UPRIGHT_LEG_OFFSET,
     DEFAULT_MAX_ITERATIONS,
@@ -287,29 +288,52 @@ def test_warm_start_from_the_solution_needs_no_further_sweep():
     assert np.percentile(hinge_moves, 99) < 0.5  # measured 0.41: no knee flips to a mirror pose
 
 
-def test_an_upright_leg_keeps_its_knee_on_its_own_side():
-    # The quadruped's left front leg: its rest foot beside its hip (free azimuth). Of the two leg planes
-    # through a target ahead and outside the hip, the one turned under the body (reached from a warm
-    # start on that side) folds the knee across the other legs; restarts find the outward one.
+def test_an_abduction_joint_rolls_the_leg_plane_by_hand():
+    # The quadruped's legs stand under their hips beside the body: their plane joint is an abduction.
+    # The plane faces forward and rolls about the forward axis: a leg hanging straight down (pitch_0 =
+    # pi/2, no bend) rolled by q0 puts its foot at hip + L (0, -cos q0, -sin q0) (q0 > 0: to the right).
+    creature = load_creature("quadruped")
+    legs = legs_of(creature)
+    assert legs.plane_rolls.all() and np.all(legs.rest_azimuths == 0.0)
+    leg = creature.leg_names.index("LF")
+    length = legs.segment_lengths[leg].sum()
+    for q0 in (0.0, 0.3, -0.45):
+        angles = np.array([[q0, 0.5 * math.pi, 0.0, 0.0]])
+        joints = forward_legs(legs.hips[leg][None], np.eye(3)[None], legs.rest_azimuths[leg:leg + 1],
+                              legs.segment_lengths[leg:leg + 1], angles, plane_rolls=legs.plane_rolls[leg:leg + 1])
+        np.testing.assert_allclose(joints[0, -1], legs.hips[leg] + length * np.array([0.0, -math.cos(q0), -math.sin(q0)]),
+                                   atol=1e-12)
+    # the same angles without the roll flag: an azimuth joint turning the plane about the up axis (the
+    # leg hangs straight down whatever the azimuth)
+    flat = forward_legs(legs.hips[leg][None], np.eye(3)[None], legs.rest_azimuths[leg:leg + 1],
+                        legs.segment_lengths[leg:leg + 1], np.array([[0.3, 0.5 * math.pi, 0.0, 0.0]]))
+    np.testing.assert_allclose(flat[0, -1], legs.hips[leg] + length * np.array([0.0, -1.0, 0.0]), atol=1e-12)
+
+
+def test_an_upright_leg_keeps_its_knee_in_its_fore_aft_plane_as_its_foot_passes_the_hip():
+    # A stance foot passes its hip from front to back, beside the hip's fore-aft line (outside and
+    # inside it): a leg whose plane turned about the up axis swung its plane half a circle as the foot
+    # passed, folding the knee under the body across the other legs. The abducting leg reaches every
+    # target frame to frame (warm started, as the runtime does), its plane rolls by small steps and
+    # its knee stays within a few cm of the hip's fore-aft line.
     creature = load_creature("quadruped")
     legs = legs_of(creature)
     leg = creature.leg_names.index("LF")
-    alpha = legs.rest_azimuths[leg]
-    assert legs.azimuth_limits[leg] == math.pi and math.sin(alpha) > 0.5  # premise: upright, on the left
     hip = legs.hips[leg]
-    target = hip + np.array([0.10, -0.40, 0.03])
-    # Warm start: the leg plane at rest (outward), the leg folded back behind the hip: the first descent
-    # turns the plane to the side of the folded foot, away from the target, under the body.
-    warm = np.array([[0.0, 1.5, 1.6, 1.6]])
+    angles = rest_pose_angles(creature)[leg:leg + 1]
     args = (hip[None], np.eye(3)[None], legs.rest_azimuths[leg:leg + 1], legs.segment_lengths[leg:leg + 1],
-            legs.limits[leg:leg + 1], legs.azimuth_limits[leg:leg + 1], target[None])
-    kept = solve_legs(*args, warm_start=warm, restarts=0)  # no restart: the first descent's pose
-    assert kept.converged[0] and math.sin(alpha + kept.angles[0, 0]) < 0.0  # premise: converged, knee inward
-    turned = solve_legs(*args, warm_start=warm)
-    assert turned.converged[0]
-    assert math.sin(alpha + turned.angles[0, 0]) > 0.0  # the leg plane points out to the left
-    knee = turned.joints[0, 2] - hip
-    assert knee[2] > 0.0, knee  # and so does the knee
+            legs.limits[leg:leg + 1], legs.azimuth_limits[leg:leg + 1])
+    for lateral in (0.04, 0.0, -0.03):  # outside, on and inside the hip's fore-aft line
+        pose = angles.copy()
+        for forward in np.linspace(0.15, -0.15, 61):  # 5 mm a frame
+            target = hip + np.array([forward, -0.40, lateral])
+            result = solve_legs(*args, target[None], warm_start=pose, plane_rolls=legs.plane_rolls[leg:leg + 1])
+            assert result.converged[0], (lateral, forward, result.residual)
+            if forward < 0.15:  # from the first target on (the rest pose is farther)
+                assert abs(result.angles[0, 0] - pose[0, 0]) < 0.02, (lateral, forward)  # the plane: no turn
+            knee = result.joints[0, 2] - hip
+            assert abs(knee[2]) < 0.05, (lateral, forward, knee)
+            pose = result.angles
 
 
 def test_serial_and_parallel_kernels_are_bit_identical():
@@ -377,26 +401,33 @@ def test_rest_pose_angles_put_every_foot_on_its_rest_spot(name):
     n, s = creature.n_legs, creature.n_segments
     assert legs.hips.shape == (n, 3) and legs.segment_lengths.shape == (n, s)
     assert legs.limits.shape == (n, s, 2)
-    # Legs standing under their hip (the quadruped's) get a free azimuth, the others the default limit.
+    # Legs standing under their hip beside the body (the quadruped's) get an abduction joint and a
+    # forward-facing plane, the others an azimuth joint with the default limit, facing their rest foot.
     offset = np.hypot(creature.rest_feet[:, 0] - creature.hips[:, 0], creature.rest_feet[:, 1] - creature.hips[:, 2])
     upright = offset < UPRIGHT_LEG_OFFSET * creature.leg_reach
-    np.testing.assert_array_equal(legs.azimuth_limits, np.where(upright, np.pi, DEFAULT_AZIMUTH_LIMIT))
+    np.testing.assert_array_equal(legs.plane_rolls, upright)
+    np.testing.assert_array_equal(legs.azimuth_limits, np.where(upright, ABDUCTION_LIMIT, DEFAULT_AZIMUTH_LIMIT))
     assert upright.all() == (creature.name == 'quadruped') and upright.any() == (creature.name == 'quadruped')
     directions = np.column_stack([np.cos(legs.rest_azimuths), np.sin(legs.rest_azimuths)])
-    np.testing.assert_allclose(directions, creature.foot_directions, atol=1e-12)
+    np.testing.assert_allclose(directions, np.where(upright[:, None], [1.0, 0.0], creature.foot_directions),
+                               atol=1e-12)
 
     angles = rest_pose_angles(creature)
     assert angles.shape == (n, s + 1)
     assert_within_limits(angles, legs.limits, legs.azimuth_limits)
-    np.testing.assert_allclose(angles[:, 0], 0.0, atol=1e-9)  # rest feet lie along the rest azimuths
-    feet = forward_legs(legs.hips, tile(np.eye(3), n), legs.rest_azimuths, legs.segment_lengths, angles)[:, -1]
+    # rest feet lie along the rest azimuths; an abducting leg's plane rolls through its rest foot
+    rest = rest_feet_body(creature) - legs.hips
+    rolled = np.arctan2(-rest[:, 2], -rest[:, 1])
+    np.testing.assert_allclose(angles[:, 0], np.where(upright, rolled, 0.0), atol=1e-9)
+    feet = forward_legs(legs.hips, tile(np.eye(3), n), legs.rest_azimuths, legs.segment_lengths, angles,
+                        legs.plane_rolls)[:, -1]
     np.testing.assert_allclose(feet, rest_feet_body(creature), rtol=0, atol=1e-8)
     # posed in the world: the same angles put the feet on the posed rest spots
     pelvis, r = np.array([1.0, 0.3, 2.0]), body_rotation(0.8, 0.1, -0.1)
     hips = legs.world_hips(pelvis, r)
     np.testing.assert_allclose(hips, legs.world_hips(pelvis, [0.8, 0.1, -0.1]), atol=1e-15)
     world = solve_legs(hips, tile(r, n), legs.rest_azimuths, legs.segment_lengths, legs.limits, legs.azimuth_limits,
-                       pelvis + rest_feet_body(creature) @ r.T, warm_start=angles)
+                       pelvis + rest_feet_body(creature) @ r.T, warm_start=angles, plane_rolls=legs.plane_rolls)
     assert np.all(world.iterations == 0)
 
 

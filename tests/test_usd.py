@@ -142,7 +142,7 @@ def test_skeleton_forward_kinematics_is_the_ik_chain(exported, run):
             rotation = body_rotation(*recording.orientation[k, c])
             hips = recording.pelvis[k, c] + legs.hips @ rotation.T
             expected = forward_legs(hips, np.broadcast_to(rotation, (legs.n_legs, 3, 3)), legs.rest_azimuths,
-                                    legs.segment_lengths, recording.joint_angles[k, c])
+                                    legs.segment_lengths, recording.joint_angles[k, c], legs.plane_rolls)
             np.testing.assert_allclose(joints, expected, rtol=0, atol=FK_TOLERANCE_M, err_msg=f"frame {k}")
         # last frame: the skinned mesh's foot ends are where the IK put the feet (its own float64 result)
         skinning = skel_query.ComputeSkinningTransforms(code)
@@ -172,7 +172,7 @@ def test_skeleton_chain_of_every_creature_at_random_poses(name):
         world = _world_matrices(_row_matrices(rotations, translations), layout.parents)
         rotation = body_rotation(*orientation)
         expected = forward_legs(pelvis + legs.hips @ rotation.T, np.broadcast_to(rotation, (legs.n_legs, 3, 3)),
-                                legs.rest_azimuths, legs.segment_lengths, angles)
+                                legs.rest_azimuths, legs.segment_lengths, angles, legs.plane_rolls)
         np.testing.assert_allclose(world[layout.leg_joints, 3, :3], expected, rtol=0, atol=ROUND_OFF_M)
 
 
