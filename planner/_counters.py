@@ -58,8 +58,9 @@ def rendered_joints(model, state) -> np.ndarray:
     legs = model.leg_static
     hips = hips_world(model, state)
     rotations = np.repeat(body_rotation(state.heading, state.pitch, state.roll)[:, None], l, axis=1)
-    # The kernel itself (the runtime's own arrays, checked when the crowd was built): the checked
-    # forward_legs costs 3 ms a frame for 1000 spiders, and the controller calls this every frame.
+    # The kernel itself on the runtime's own arrays (checked when the crowd was built): the controller
+    # calls this every frame, and forward_legs would check and copy them again (the kernel alone:
+    # 0.74 ms for 1000 spiders' 8000 legs on 2 cores).
     joints = np.empty((c * l, legs.segment_lengths.shape[1] + 2, 3))
     forward_kinematics_batch(np.ascontiguousarray(hips.reshape(-1, 3)), rotations.reshape(-1, 3, 3),
                              np.tile(legs.rest_azimuths, c), np.tile(legs.plane_rolls, c),
