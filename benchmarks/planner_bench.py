@@ -19,7 +19,7 @@ import numpy as np
 
 from planner import DEFAULT_BUDGET, EXHAUSTIVE, FIRST_VALID, PlannerConfig, ScoringWeights, make_batch
 from planner._kernels_batch import plan_feet_serial
-from planner._kernels_foot import footprint_candidates, prepare_foot, slice_maps
+from planner._kernels_foot import footprint_candidates, prepare_foot, slice_maps, swing_reach
 from planner._kernels_geometry import foot_offsets
 from planner._kernels_wavefront import per_target_wavefronts, wavefront
 from planner._search import MODES
@@ -84,8 +84,11 @@ def _wavefront_grids(maps, requests, weights, config):
         passable = np.empty(n, np.uint8)
         factor = np.empty(n)
         dt = np.empty(n)
-        slice_maps(code, boxh, np.inf, config.slice_epsilon_m, source, hp, wp, cell, config.potential_range_m,
-                   config.potential_gain, passable, factor, dt)
+        in_reach = np.empty(n, np.uint8)
+        swing_reach(r0, c0, hp, wp, m.frame.origin_x, m.frame.origin_z, cell, q.source[0], q.source[2], q.hip[0],
+                    q.hip[1], q.reach_xz, in_reach)
+        slice_maps(code, boxh, np.inf, config.slice_epsilon_m, source, in_reach, hp, wp, cell,
+                   config.potential_range_m, config.potential_gain, passable, factor, dt)
         grids.append((passable, factor, wp, hp, source, cands))
     return grids
 

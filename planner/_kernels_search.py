@@ -66,6 +66,7 @@ from planner._kernels_foot import (
     resample_by_arclength,
     slice_levels,
     slice_maps,
+    swing_reach,
     trajectory_goodness,
     weighted_mean,
 )
@@ -94,8 +95,9 @@ def foot_setup(elevation, ground, forbidden, origin_x, origin_z, offsets, source
                feet_block_radius, w, cfg, slice_size):
     """ROI maps, potential footprints, slices and d_ref of one foot (shared by the search and the
     harvest). Returns (code, elev_dil, boxh_dil, r0, c0, hp, wp, source_p, cand, cand_terms,
-    cand_scores, cand_features, cand_rc, levels, d_ref (n,), cand_xz) - ``cand_xz`` (n, 2) the
-    continuous footprints (:func:`planner._kernels_foot.footprint_point`)."""
+    cand_scores, cand_features, cand_rc, levels, d_ref (n,), cand_xz, in_reach) - ``cand_xz`` (n, 2) the
+    continuous footprints (:func:`planner._kernels_foot.footprint_point`), ``in_reach`` the cells a swing
+    may pass (:func:`planner._kernels_foot.swing_reach`)."""
     cell = cfg[C_CELL]
     radius = cfg[C_RADIUS]
     pref_x = preferred[0]
@@ -116,8 +118,10 @@ def foot_setup(elevation, ground, forbidden, origin_x, origin_z, offsets, source
         cand_rc[k, 1] = c0 - 1 + (cand[k] - rr * wp)
     levels = slice_levels(code, boxh_dil, slice_size, cfg[C_SLICE_EPS])
     d_ref = directness_references(cand_xz, source[0], source[2], cell)
+    in_reach = np.empty(hp * wp, dtype=np.uint8)
+    swing_reach(r0, c0, hp, wp, origin_x, origin_z, cell, source[0], source[2], hip[0], hip[1], reach_xz, in_reach)
     return (code, elev_dil, boxh_dil, r0, c0, hp, wp, source_p, cand, cand_terms, cand_scores, cand_features, cand_rc,
-            levels, d_ref, cand_xz)
+            levels, d_ref, cand_xz, in_reach)
 
 
 @nb.njit(cache=True)
@@ -152,7 +156,7 @@ def plan_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, 
     source_z = source[2]
     counters = np.zeros(N_COUNTERS, dtype=np.int64)
     (code, elev_dil, boxh_dil, r0, c0, hp, wp, source_p, cand, cand_terms, cand_scores, _, cand_rc, levels,
-     d_ref, cand_xz) = foot_setup(elevation, ground, forbidden, origin_x, origin_z, offsets, source, preferred, hip, reach_xz,
+     d_ref, cand_xz, in_reach) = foot_setup(elevation, ground, forbidden, origin_x, origin_z, offsets, source, preferred, hip, reach_xz,
                          other_legs, feet_block_radius, w, cfg, slice_size)
     n = hp * wp
     n_cand = cand.size
@@ -214,7 +218,7 @@ def plan_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, 
             if boxh_dil[tp] > levels[s] + eps:
                 continue  # the target itself is above this slice: not reachable in it
             if not ready[s]:
-                slice_maps(code, boxh_dil, levels[s], eps, source_p, hp, wp, cell, cfg[C_POT_RANGE], cfg[C_POT_GAIN],
+                slice_maps(code, boxh_dil, levels[s], eps, source_p, in_reach, hp, wp, cell, cfg[C_POT_RANGE], cfg[C_POT_GAIN],
                            passable[s], factor[s], dt[s])
                 if mode == MODE_SEARCH:
                     m = 0
@@ -328,7 +332,7 @@ def harvest_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offset
     source_y = source[1]
     source_z = source[2]
     (code, elev_dil, boxh_dil, r0, c0, hp, wp, source_p, cand, cand_terms, cand_scores, cand_features, cand_rc, levels,
-     d_ref, cand_xz) = foot_setup(elevation, ground, forbidden, origin_x, origin_z, offsets, source, preferred, hip, reach_xz,
+     d_ref, cand_xz, in_reach) = foot_setup(elevation, ground, forbidden, origin_x, origin_z, offsets, source, preferred, hip, reach_xz,
                          other_legs, feet_block_radius, w, cfg, slice_size)
     n = hp * wp
     n_cand = cand.size
@@ -359,7 +363,7 @@ def harvest_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offset
                 m += 1
         if m == 0:
             continue
-        slice_maps(code, boxh_dil, levels[s], eps, source_p, hp, wp, cell, cfg[C_POT_RANGE], cfg[C_POT_GAIN],
+        slice_maps(code, boxh_dil, levels[s], eps, source_p, in_reach, hp, wp, cell, cfg[C_POT_RANGE], cfg[C_POT_GAIN],
                    passable, factor, dt)
         wavefront(passable, factor, wp, source_p, cell, stop[:m], dist, parent)
         for k in range(n_cand):

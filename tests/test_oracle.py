@@ -13,8 +13,9 @@ documented definitions (the field docs of ``planner/_weights.py``, the docstring
   the cell, else the cell's point nearest to it; a point within a foot's room of another foot, or
   in the preferred footprint's own cell under another leg within a foot's room of that leg, moved
   straight out of that room), the five footprint features and goodnesses;
-* the elevation slices (§5.2), the passable cells of each, the distance to blocked cells (the
-  documented chamfer metric: octile distance between cell centres) and the potential field;
+* the elevation slices (§5.2), the passable cells of each (free, and within the swing's reach of
+  the hip), the distance to blocked cells (the documented chamfer metric: octile distance between
+  cell centres) and the potential field;
 * the wavefront as scipy's Dijkstra, with *every* shortest path enumerated (ties between equal
   paths are explicit: a couple whose paths differ keeps the set of their scores);
 * line-of-sight refinement of the naive cells, the Hermite path (Catmull-Rom tangents, then
@@ -381,7 +382,14 @@ class Oracle:
     def _slice(self, level):
         eps, cell = self.cfg.slice_epsilon_m, self.cell
         ok = (self.code == FREE) & (self.boxh_dil <= level + eps)
-        passable = ok.copy()
+        # A swing stays within its leg's reach of the hip it lands under (or as far as the source,
+        # if further), grown by half a cell's diagonal: cells beyond are not passed, yet block nothing.
+        hip_x, hip_z = (float(v) for v in self.q.hip)
+        radius = max(self.q.reach_xz, math.hypot(self.src_x - hip_x, self.src_z - hip_z)) + 0.5 * SQRT2 * cell
+        centres = np.array([[cell_centre(r, c, self.ox, self.oz, cell) for c in range(self.n_cols)]
+                            for r in range(self.n_rows)])
+        in_reach = np.hypot(centres[..., 0] - hip_x, centres[..., 1] - hip_z) <= radius
+        passable = ok & in_reach
         passable[self.src_rc] = True
         clearance = octile_distance_map(~ok, cell)  # distance to the blocked cells of this slice
         rng = self.cfg.potential_range_m

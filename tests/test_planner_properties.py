@@ -13,7 +13,7 @@ import math
 import numpy as np
 import pytest
 
-from planner import EXHAUSTIVE, FIRST_VALID, DEFAULT_BUDGET, FootQuery, GridFrame, LocalMaps, plan_foot
+from planner import EXHAUSTIVE, FIRST_VALID, DEFAULT_BUDGET, FootQuery, GridFrame, LocalMaps, PlannerConfig, plan_foot
 from planner._kernels_geometry import foot_offsets, rasterise_boxes
 
 N_LAYOUTS = 1000
@@ -233,3 +233,35 @@ def test_batch_kernel_equals_single_foot_calls():
         np.testing.assert_array_equal(out.trajectory[i], r.trajectory)
         np.testing.assert_array_equal(out.target[i], r.target)
         assert out.scores[i, 0] == r.couple_score
+
+
+
+def _walled(rows):
+    """A 25 x 25 map of 0.1 m cells, flat, with a forbidden wall in column 11 (x 1.1-1.2) over ``rows``."""
+    forbidden = np.zeros((25, 25), np.uint8)
+    forbidden[rows, 11] = 1
+    return LocalMaps(GridFrame(0.0, 0.0, 0.1, 25, 25), np.zeros((25, 25)), np.zeros((25, 25)), forbidden)
+
+
+# The foot stands at (0.95, 1.25), west of the wall; it lands under a hip at (1.25, 1.25), on the wall's
+# line, preferred 0.3 m east of it; the leg reaches 0.45 m. A swing passes only within
+# max(0.45, |source - hip| = 0.30) + half a cell's diagonal (0.0707) = 0.5207 m of the hip.
+WALL_QUERY = FootQuery(source=(0.95, 0.0, 1.25), preferred=(1.55, 1.25), hip=(1.25, 1.25), reach_xz=0.45,
+                       step_height=0.05, foot_length=0.04, foot_width=0.02, foot_yaw=0.0)
+WALL_REACH = 0.45 + 0.05 * math.sqrt(2.0)
+WALL_CONFIG = PlannerConfig(cell_size=0.1)
+
+
+def test_a_swing_does_not_leave_its_legs_reach_to_go_round_a_wall():
+    # Wall over z 0.6-1.9: the way round (inside the search's region, rows 4-20) passes z 0.45 or
+    # 2.05, 0.8 m from the hip. No couple: the foot holds. (A spider's foot once looped 1 m round a
+    # crate for a 0.29 m step, and was drawn inside the crate at the end of its stretched leg.)
+    r = plan_foot(_walled(slice(6, 19)), WALL_QUERY, budget=EXHAUSTIVE, config=WALL_CONFIG)
+    assert not r.valid
+    # Wall over z 1.1-1.4 (its foot-size ring over z 1.0-1.5): the way round stays within reach.
+    r = plan_foot(_walled(slice(11, 14)), WALL_QUERY, budget=EXHAUSTIVE, config=WALL_CONFIG)
+    assert r.valid
+    assert r.target[0] > 1.2  # east of the wall
+    reach = np.hypot(r.trajectory[:, 0] - 1.25, r.trajectory[:, 2] - 1.25)
+    assert reach.max() <= WALL_REACH
+    assert np.abs(r.trajectory[:, 2] - 1.25).max() > 0.2  # it went round, not through
