@@ -302,16 +302,19 @@ def test_a_terrain_preset_passes_only_with_a_win_at_home_and_no_loss_elsewhere()
     worse = _events(base + 0.02 + 0.005 * rng.standard_normal(30))
     cells = {"stairs": evaluate_cell(default, better, {}), "crates": evaluate_cell(default, same, {})}
     assert cells["stairs"]["main"]["gain_se"] > 2.0
-    assert verdict("spider-stairs", cells, {}) == (True, [])
+    assert verdict("spider-stairs", cells, {}, 0.5) == (True, [])
+    # the same win from weights 18 % off the defaults at most: no preset of its own (issue 18: >= 20 %)
+    passes, why = verdict("spider-stairs", cells, {}, 0.18)
+    assert not passes and why == ["its weights differ from the defaults by 18.0% at most < 20%"]
     cells["crates"] = evaluate_cell(default, worse, {})
-    passes, why = verdict("spider-stairs", cells, {})
+    passes, why = verdict("spider-stairs", cells, {}, 0.5)
     assert not passes and "crates" in why[0]
     cells = {"stairs": evaluate_cell(default, same, {}), "crates": evaluate_cell(default, same, {})}
-    assert not verdict("spider-stairs", cells, {})[0]
+    assert not verdict("spider-stairs", cells, {}, 0.5)[0]
     better_values = [r["stride_error"] for r in better["runs"]]
     collided = evaluate_cell(default, _events(better_values, collisions=1), {})  # one run with a collision
     assert collided["collisions_rise"]
-    assert not verdict("spider-stairs", {"stairs": collided}, {})[0]
+    assert not verdict("spider-stairs", {"stairs": collided}, {}, 0.5)[0]
 
 
 def test_a_style_preset_passes_when_its_metric_moves_toward_its_bound():
@@ -326,9 +329,9 @@ def test_a_style_preset_passes_when_its_metric_moves_toward_its_bound():
     down = _events(stride, near_box_share=near + 0.05)
     good = {t: evaluate_cell(default, up, style) for t in ("crates", "mixed")}
     assert good["crates"]["style"]["min_clearance_body_heights"]["gain_se"] > 2.0
-    assert verdict("spider-cautious", good, style) == (True, [])
+    assert verdict("spider-cautious", good, style, 0.5) == (True, [])
     bad = {t: evaluate_cell(default, down, style) for t in ("crates", "mixed")}
-    assert not verdict("spider-cautious", bad, style)[0]
+    assert not verdict("spider-cautious", bad, style, 0.5)[0]
 
 
 def test_the_reports_matrix_section_shows_every_preset_its_cells_and_verdict():
@@ -338,7 +341,7 @@ def test_the_reports_matrix_section_shows_every_preset_its_cells_and_verdict():
     rng = np.random.default_rng(2)
     base = 0.1 + 0.01 * rng.standard_normal(30)
     cell = evaluate_cell(_events(base), _events(base - 0.02), {})
-    passes, why = verdict("spider-stairs", {"stairs": cell}, {})
+    passes, why = verdict("spider-stairs", {"stairs": cell}, {}, 0.5)
     matrix = {"terrains": {"stairs": "stairs@terrain.rise=0.1,terrain.run=0.3"}, "runs_per_cell": 30, "win_se": 2.0,
               "loss_se": 1.0, "presets": {
                   "spider-stairs": {"found": True, "passes": passes, "why": why, "command": "footfall tune X",

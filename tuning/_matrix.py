@@ -15,7 +15,8 @@ A preset **passes** (``footfall bench presets`` says so, and only a passing pres
 * a style preset: on each terrain it was tuned for, its first style metric moves >= :data:`WIN_SE`
   toward its bound;
 * both: no rise of collisions and body overlaps over the defaults' in any cell
-  (:func:`tuning._events.collisions_rise`).
+  (:func:`tuning._events.collisions_rise`), and some weight differs from its default by at least
+  :data:`MIN_WEIGHT_CHANGE`.
 
 Regenerate a preset with its ``command`` (:data:`PRESETS`), then the matrix with
 ``footfall bench presets --out tuning/data/matrix.json`` (:func:`run_matrix`). The runs are
@@ -46,6 +47,9 @@ SEED_BASE = 500
 MAIN_METRIC = "stride_error"
 WIN_SE = 2.0
 LOSS_SE = 1.0
+MIN_WEIGHT_CHANGE = 0.20
+"""A shipped preset differs from the default weights, some weight by at least this fraction (issue 18,
+item 4): a preset within a few per cent of the defaults carries no information of its own."""
 RUNS = 30
 SPAWNS = (0.15, 0.3, 0.45)
 
@@ -119,10 +123,13 @@ def evaluate_cell(default: dict, preset: dict, style: dict) -> dict:
     return cell
 
 
-def verdict(name: str, cells: dict, style: dict) -> tuple[bool, list[str]]:
-    """(passes, reasons it does not) of a preset from its cells (module docstring)."""
+def verdict(name: str, cells: dict, style: dict, weight_change: float) -> tuple[bool, list[str]]:
+    """(passes, reasons it does not) of a preset from its cells and its largest relative weight change
+    from the defaults (module docstring)."""
     spec = PRESETS[name]
     why = []
+    if not weight_change >= MIN_WEIGHT_CHANGE:
+        why.append(f"its weights differ from the defaults by {weight_change:.1%} at most < {MIN_WEIGHT_CHANGE:.0%}")
     for terrain, cell in cells.items():
         if cell["collisions_rise"]:
             why.append(f"{terrain}: collisions rise {cell['collisions_default']} -> {cell['collisions_preset']}")
@@ -191,9 +198,9 @@ def run_matrix(presets_dir: str | Path, names=None, runs: int = RUNS, terrains=N
             say(f"{name} on {terrain}")
             mine = event_metrics(setup, preset.weights, preset.timing or targets.timing(), targets, map_tasks)
             cells[terrain] = evaluate_cell(defaults[key], mine, style)
-        passes, why = verdict(name, cells, style)
         w0 = ScoringWeights().to_array()
         w = preset.weights.to_array()
+        passes, why = verdict(name, cells, style, float(np.max(np.abs(w / w0 - 1.0))))
         out["presets"][name] = {
             "found": True, "creature": creature, "kind": "terrain" if "terrain" in spec else "style",
             "for": spec.get("terrain") or list(spec["terrains"]), "style": style, "command": spec["command"],
