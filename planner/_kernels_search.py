@@ -156,8 +156,9 @@ def plan_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, 
     source_z = source[2]
     counters = np.zeros(N_COUNTERS, dtype=np.int64)
     (code, elev_dil, boxh_dil, r0, c0, hp, wp, source_p, cand, cand_terms, cand_scores, _, cand_rc, levels,
-     d_ref, cand_xz, in_reach) = foot_setup(elevation, ground, forbidden, origin_x, origin_z, offsets, source, preferred, hip, reach_xz,
-                         other_legs, feet_block_radius, w, cfg, slice_size)
+     d_ref, cand_xz, in_reach) = foot_setup(elevation, ground, forbidden, origin_x, origin_z, offsets, source,
+                                            preferred, hip, reach_xz, other_legs, feet_block_radius, w, cfg,
+                                            slice_size)
     n = hp * wp
     n_cand = cand.size
     counters[CNT_CANDIDATES] = n_cand
@@ -218,8 +219,8 @@ def plan_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, 
             if boxh_dil[tp] > levels[s] + eps:
                 continue  # the target itself is above this slice: not reachable in it
             if not ready[s]:
-                slice_maps(code, boxh_dil, levels[s], eps, source_p, in_reach, hp, wp, cell, cfg[C_POT_RANGE], cfg[C_POT_GAIN],
-                           passable[s], factor[s], dt[s])
+                slice_maps(code, boxh_dil, levels[s], eps, source_p, in_reach, hp, wp, cell, cfg[C_POT_RANGE],
+                           cfg[C_POT_GAIN], passable[s], factor[s], dt[s])
                 if mode == MODE_SEARCH:
                     m = 0
                     for q in range(n_cand):
@@ -332,8 +333,9 @@ def harvest_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offset
     source_y = source[1]
     source_z = source[2]
     (code, elev_dil, boxh_dil, r0, c0, hp, wp, source_p, cand, cand_terms, cand_scores, cand_features, cand_rc, levels,
-     d_ref, cand_xz, in_reach) = foot_setup(elevation, ground, forbidden, origin_x, origin_z, offsets, source, preferred, hip, reach_xz,
-                         other_legs, feet_block_radius, w, cfg, slice_size)
+     d_ref, cand_xz, in_reach) = foot_setup(elevation, ground, forbidden, origin_x, origin_z, offsets, source,
+                                            preferred, hip, reach_xz, other_legs, feet_block_radius, w, cfg,
+                                            slice_size)
     n = hp * wp
     n_cand = cand.size
     n_slices = levels.size

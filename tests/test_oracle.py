@@ -850,6 +850,14 @@ def test_every_couple_scores_as_the_oracle_says(seed):
                 f"{where}: the runtime scores {score:.12f}, the oracle {_describe(couple)}"
 
 
+# A fresh seed that failed (session 14; it fails on f93235d too, before the swing-reach rule): one couple
+# scores 0.496454823260 in the runtime and 0.496457128570 in the oracle (cell (8, 11), slice 1), 2.3e-6
+# apart. Not traced yet; kept here so that it stays checked and turns this test red once it is fixed.
+@pytest.mark.xfail(strict=True, reason="seed 251713580: a couple's score differs from the oracle's by 2.3e-6")
+def test_every_couple_scores_as_the_oracle_says_on_a_seed_that_failed():
+    test_every_couple_scores_as_the_oracle_says(251713580)
+
+
 # ---------------------------------------------------------------------------- disagreements (fixed)
 
 
