@@ -47,16 +47,18 @@ STUCK_FRACTION = 0.1
 """A character moving less than this fraction of its asked speed over the window is stuck."""
 
 
-def rendered_joints(model, state) -> np.ndarray:
+def rendered_joints(model, state, hips=None) -> np.ndarray:
     """(C, L, S + 2, 3) joint positions as drawn: forward kinematics of the IK angles, the hip
-    first and the foot last; for characters whose IK is off, a straight hip -> planned foot leg."""
+    first and the foot last; for characters whose IK is off, a straight hip -> planned foot leg.
+    ``hips``: the state's (C, L, 3) hips (:func:`planner._crowd.hips_world`) if the caller has them."""
     from planner._crowd import hips_world
     from planner._ik import body_rotation
     from planner._kernels_ik import forward_kinematics_batch
 
     c, l = state.in_stance.shape
     legs = model.leg_static
-    hips = hips_world(model, state)
+    if hips is None:
+        hips = hips_world(model, state)
     rotations = np.repeat(body_rotation(state.heading, state.pitch, state.roll)[:, None], l, axis=1)
     # The kernel itself on the runtime's own arrays (checked when the crowd was built): the controller
     # calls this every frame, and forward_legs would check and copy them again (the kernel alone:

@@ -715,8 +715,7 @@ def _solve_feet(model: CrowdModel, state: CrowdState, cs, ls, hips, iterations: 
     # The body poses as (yaw, pitch, roll): rotations built from angles need no orthonormality check.
     pose = np.column_stack([state.heading[cs], state.pitch[cs], state.roll[cs]])
     return solve_legs_trusted(hips, pose, legs.rest_azimuths[ls], legs.plane_rolls[ls], legs.segment_lengths[ls],
-                              legs.limits[ls],
-                              np.broadcast_to(legs.azimuth_limits, legs.rest_azimuths.shape)[ls],
+                              legs.limits[ls], np.broadcast_to(legs.azimuth_limits, legs.rest_azimuths.shape)[ls],
                               state.feet[cs, ls], state.angles[cs, ls], iterations, restarts, two_bone=two_bone)
 
 
@@ -797,7 +796,7 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, fre
     far |= cannot_follow | (stance_room(model, state) <= 0.0) | (leg_speed_caps(model, state) < 0.5 * goal)
     # A stance foot the body turned across another leg steps (its own side again).
     crossing = np.empty(state.in_stance.shape, dtype=np.bool_)
-    stance_legs_crossing(np.ascontiguousarray(rendered_joints(model, state)), state.in_stance, crossing)
+    stance_legs_crossing(np.ascontiguousarray(rendered_joints(model, state, hips)), state.in_stance, crossing)
     far |= crossing
     centres, sizes, yaws, forbidden, moving = boxes
     threatened = np.zeros(state.in_stance.shape, dtype=np.bool_)

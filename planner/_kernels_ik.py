@@ -551,12 +551,7 @@ def _solve_one(b, hips, rotations, rest_azimuths, plane_rolls, lengths, limits, 
         used += sweeps
         # a restart must converge or beat the best by more than the tolerance: no jump to another
         # pose for nothing (the polish continues the best pose, it never ends worse)
-        if have_best and best_residual < tolerance:
-            # Nothing replaces a pose that reaches its foot (not a pose closer by round-off: the same
-            # legs posed in a rotated frame must get the same angles).
-            better = False
-        else:
-            better = residual < best_residual and (residual < tolerance or residual < best_residual - tolerance)
+        better = residual < best_residual and (residual < tolerance or residual < best_residual - tolerance)
         if not have_best or polish or better:
             have_best = True
             best_seeded = seeded
@@ -567,6 +562,8 @@ def _solve_one(b, hips, rotations, rest_azimuths, plane_rolls, lengths, limits, 
         if polish or used >= max_iterations:
             break
         if best_residual < tolerance:
+            # Nothing replaces a pose that reaches its foot (not a pose closer by round-off: the same
+            # legs posed in a rotated frame must get the same angles).
             break
         if attempt < restarts:
             # stalled or stuck: restart from the next grid pose, nearest first
