@@ -234,6 +234,7 @@ class CrowdState:
     pose_before: np.ndarray  # (C, 6) pelvis x, y, z, heading, pitch, roll at the start of the frame
     gait_index: np.ndarray  # (C,) int: the schedule's gait each character walks with (or moves toward)
     stride_frequency: np.ndarray  # (C,) Hz, the needle's rate at the last gait stage
+    turn_wanted: np.ndarray  # (C,) rad, the turn the steering asked of the last frame, before the stance feet bound it
     counters: dict = field(default_factory=dict)
     last_plans: object = None  # (chars, legs, kinds, BatchResult) of the last frame, for recordings
     last_batch: object = None  # the FootBatch planned in the last frame (what the tuning harvest re-scores)
@@ -333,7 +334,7 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
     braking = np.where(state.route_index == last, arrival_speed(dist, ctl.arrive_radius, ctl.acceleration), np.inf)
     goal_speed = np.where(arrived, 0.0, np.minimum(np.minimum(state.desired_speed, state.speed_limit), braking))
     preferred = direction * goal_speed[:, None]
-    velocity, avoided = _avoid(model, state, preferred, dist, boxes, box_velocity)
+    velocity, avoided = _avoid(model, state, preferred, dist, boxes, box_velocity, in_lane)
     fast = np.hypot(velocity[:, 0], velocity[:, 1]) > 1e-6
     direction = np.where((avoided & fast)[:, None], velocity / np.maximum(np.hypot(*velocity.T), 1e-12)[:, None],
                          direction)
@@ -348,7 +349,9 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
     rate = ctl.turn_rate * dt * np.clip(4.0 * state.speed / np.maximum(goal_speed, 1e-9), 0.25, 1.0)
     # Out of a moving box's way: turning fast is the escape (the body walks only along its heading).
     rate = np.where(in_lane, ctl.turn_rate * dt, rate)
-    state.heading = _wrap(state.heading + np.clip(turn, -rate, rate))
+    state.turn_wanted = np.clip(turn, -rate, rate)
+    lo, hi = stance_turn_bounds(model, state)
+    state.heading = _wrap(state.heading + np.clip(state.turn_wanted, lo, hi))
     forward = np.cos(np.clip(turn, -np.pi / 2, np.pi / 2))
     # Unhindered, a character keeps walking (at least 30 %) while it turns; avoiding, it walks only
     # as far along its heading as the avoiding velocity goes (sideways into a neighbour is no way out).
@@ -475,10 +478,11 @@ def _lane_exit(model: CrowdModel, state: CrowdState, direction: np.ndarray, boxe
 
 
 def _avoid(model: CrowdModel, state: CrowdState, preferred: np.ndarray, to_target: np.ndarray, boxes,
-           box_velocity: np.ndarray):
+           box_velocity: np.ndarray, escaping: np.ndarray):
     """(velocity (C, 2), avoided (C,) bool): ORCA's velocity for every character, and whether it
     differs from the preferred one (a neighbour or a box is in the way). ``boxes`` as
-    :func:`_boxes_now` gives them, ``box_velocity`` from :func:`_box_velocities`."""
+    :func:`_boxes_now` gives them, ``box_velocity`` from :func:`_box_velocities`; ``escaping`` (C,)
+    bool: characters leaving a moving box's lane, whom their neighbours make way for."""
     from planner._kernels_avoidance import neighbour_lists, orca_velocities
 
     n = state.pelvis.shape[0]
@@ -506,7 +510,8 @@ def _avoid(model: CrowdModel, state: CrowdState, preferred: np.ndarray, to_targe
     velocity = np.stack([np.cos(state.heading), np.sin(state.heading)], axis=1) * state.speed[:, None]
     out = np.empty((n, 2))
     orca_velocities(xz, np.ascontiguousarray(velocity), np.ascontiguousarray(preferred), np.full(n, radius),
-                    np.full(n, top), start, index, *orca_boxes, AVOID_HORIZON, AVOID_BOX_HORIZON, model.dt, out)
+                    np.full(n, top), start, index, *orca_boxes, AVOID_HORIZON, AVOID_BOX_HORIZON, model.dt,
+                    np.ascontiguousarray(escaping), out)
     avoided = np.hypot(*(out - preferred).T) > 1e-9
     return out, avoided
 
@@ -539,6 +544,11 @@ def resume_frequency(model: CrowdModel, state: CrowdState) -> np.ndarray:
 def leg_speed_caps(model: CrowdModel, state: CrowdState) -> np.ndarray:
     """(C, L) the fastest the body may move for each stance foot (inf for swinging feet)."""
     room = stance_room(model, state)
+    return np.where(state.in_stance, np.maximum(room, 0.0) / until_lift(model, state), np.inf)
+
+
+def until_lift(model: CrowdModel, state: CrowdState) -> np.ndarray:
+    """(C, L) s: how long each foot has until the needle lifts it (at least a frame)."""
     g = state.gaits
     # A body standing has no tempo (0 Hz): its feet lift when it walks again, at the tempo of the walk
     # it resumes. Counting them a cycle of 0 Hz away made every stance foot 'hold the body' (cap 0):
@@ -546,11 +556,48 @@ def leg_speed_caps(model: CrowdModel, state: CrowdState) -> np.ndarray:
     # windows never got their turn (a spider stood on a hill for good with four feet in the air).
     resume = resume_frequency(model, state)
     frequency = np.maximum(np.where(state.stride_frequency > 0.0, state.stride_frequency, resume), 1e-9)[:, None]
-    until_lift = np.mod(g.disk_start - g.needle[:, None], 1.0) / frequency + model.dt  # lifts the frame its sector starts
+    time = np.mod(g.disk_start - g.needle[:, None], 1.0) / frequency + model.dt  # lifts the frame its sector starts
     # A foot whose sector has started but which has not lifted yet (its plan is pending) lifts as
     # soon as it can: its next turn is not a cycle away.
-    until_lift = np.where(state.wants_swing | state.sector_missed, model.dt, until_lift)
-    return np.where(state.in_stance, np.maximum(room, 0.0) / until_lift, np.inf)
+    return np.where(state.wants_swing | state.sector_missed, model.dt, time)
+
+
+STANCE_SIDE_MARGIN = 0.5
+"""x the hip's lateral offset: the least a stance foot stays on its own side of the body's midline
+while the body turns (:func:`stance_turn_bounds`)."""
+
+
+def leg_turn_bounds(model: CrowdModel, state: CrowdState) -> np.ndarray:
+    """(C, L) rad: how far each body may turn this frame, toward the side its turn bound is on (its
+    sign), so that the stance foot is not carried across the midline (to within
+    ``STANCE_SIDE_MARGIN``) before the needle lifts it; ``nan`` where the foot gives no bound.
+
+    A turn swings a stance foot ``f`` ahead of the pelvis sideways by about ``-f`` times the angle in
+    the body's frame: a quadruped's front feet, 0.29 m ahead, cross under the body after 0.4 rad, and
+    its legs cross. Each stance foot gives the room it has to its margin, spread over the time until
+    it lifts (as :func:`leg_speed_caps` does for the speed); swinging feet and legs on the midline
+    give no bound.
+    """
+    side = np.sign(model.hips_body[:, 2]) * (np.abs(model.hips_body[:, 2]) > 1e-3 * model.rest_radius)
+    margin = STANCE_SIDE_MARGIN * np.abs(model.hips_body[:, 2])
+    cos, sin = np.cos(state.heading)[:, None], np.sin(state.heading)[:, None]
+    d = state.feet[:, :, [0, 2]] - state.pelvis[:, None, [0, 2]]
+    forward = d[..., 0] * cos + d[..., 1] * sin
+    lateral = -d[..., 0] * sin + d[..., 1] * cos
+    # Turning by a moves the foot's lateral coordinate by about -forward * a (a small).
+    room = np.maximum(side * lateral - margin, 0.0) * model.dt / until_lift(model, state)
+    lever = side * forward
+    bounded = state.in_stance & (side != 0.0) & (np.abs(lever) > 1e-9)
+    return np.where(bounded, room / np.where(bounded, lever, 1.0), np.nan)
+
+
+def stance_turn_bounds(model: CrowdModel, state: CrowdState) -> tuple[np.ndarray, np.ndarray]:
+    """(C,), (C,) rad: the least and most each body may turn this frame (:func:`leg_turn_bounds`)."""
+    bound = leg_turn_bounds(model, state)
+    negative = np.signbit(bound)  # bounds a turn of negative angle (-0.0: no room for one)
+    lo = np.where(negative & ~np.isnan(bound), bound, -np.inf).max(axis=1)
+    hi = np.where(~negative & ~np.isnan(bound), bound, np.inf).min(axis=1)
+    return lo, hi
 
 
 def stage_gait(model: CrowdModel, state: CrowdState):
@@ -794,6 +841,11 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, fre
     # waiting for its sector, with the body slow and the needle slower, would freeze the walk.
     goal = np.minimum(state.desired_speed, state.speed_limit)[:, None]
     far |= cannot_follow | (stance_room(model, state) <= 0.0) | (leg_speed_caps(model, state) < 0.5 * goal)
+    # So does a stance foot that stops the body's turn (stance_turn_bounds: no room left), or holds the
+    # turn of a slow body under half the turn asked: a body turning on the spot turns by stepping.
+    bound, wanted = leg_turn_bounds(model, state), state.turn_wanted[:, None]
+    holds_turn = (np.signbit(bound) == (wanted < 0.0)) & ~np.isnan(bound) & (wanted != 0.0)
+    far |= holds_turn & ((bound == 0.0) | ((np.abs(bound) < 0.5 * np.abs(wanted)) & ~walking[:, None]))
     # A stance foot the body turned across another leg steps (its own side again).
     crossing = np.empty(state.in_stance.shape, dtype=np.bool_)
     stance_legs_crossing(np.ascontiguousarray(rendered_joints(model, state, hips)), state.in_stance, crossing)
@@ -1470,7 +1522,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         feet_spacing=np.ones(n), plan_spacing=np.ones((n, L)), foot_yaws=yaws,
         gaits=init_gaits([schedule.gaits[int(k)] for k in gait_index], n, rng.uniform(0.0, 1.0, n), transition_rate=TRANSITION_RATE), angles=angles, residual=np.zeros((n, L)),
         ik_on=np.zeros(n, np.bool_), fk_feet=feet.copy(), hull=np.zeros(n), pelvis_rise=np.zeros(n), body_held=np.zeros(n, np.bool_), speed_limit=np.full(n, np.inf), last_move=np.zeros((n, 2)), cannot_follow=np.zeros((n, L), np.bool_), unfollowed=np.zeros((n, L), np.bool_), pose_before=np.zeros((n, 6)),
-        gait_index=gait_index, stride_frequency=np.zeros(n),
+        gait_index=gait_index, stride_frequency=np.zeros(n), turn_wanted=np.zeros(n),
         counters={k: 0 for k in ("steps", "plans", "holds", "replans", "forbidden_footprints", "cells_expanded",
                                  "couples_evaluated", "pose_takebacks", "map_cells_built", "ik_ccd_legs", "ik_two_bone_legs")},
         lod_level=np.full(n, LEVEL_FULL, np.int8), near_moving_box=np.zeros(n, np.bool_))

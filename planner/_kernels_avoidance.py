@@ -214,7 +214,7 @@ def _cone_line(px, py, vx, vy, r, tau, dt, share, ax, ay, out_point, out_dir, k)
 @nb.njit(cache=True, parallel=True)
 def orca_velocities(positions, velocities, preferred, radii, max_speed, neighbour_start, neighbour_index,
                     box_centres, box_half, box_yaws, box_velocities, box_active, box_pad, time_horizon,
-                    box_time_horizon, dt, out):
+                    box_time_horizon, dt, priority, out):
     """New velocity (C, 2) of every character: closest to ``preferred`` among those that avoid
     every neighbour for ``time_horizon`` seconds (sharing the effort) and every active box for
     ``box_time_horizon`` seconds (alone), at most ``max_speed``.
@@ -222,7 +222,9 @@ def orca_velocities(positions, velocities, preferred, radii, max_speed, neighbou
     positions, velocities, preferred: (C, 2) world (x, z); radii, max_speed: (C,); neighbours in
     CSR form (character c's are ``neighbour_index[neighbour_start[c]:neighbour_start[c + 1]]``);
     boxes: centres (B, 2), half extents (B, 2) along their axes, yaws (B,), velocities (B, 2),
-    ``box_active`` (B,) bool, ``box_pad`` (B,) m added to a character's radius against that box.
+    ``box_active`` (B,) bool, ``box_pad`` (B,) m added to a character's radius against that box;
+    ``priority`` (C,) bool: between a character with priority and one without, the one without
+    takes the whole effort of avoiding (between equals, each takes half).
     """
     n = positions.shape[0]
     for c in nb.prange(n):
@@ -265,8 +267,9 @@ def orca_velocities(positions, velocities, preferred, radii, max_speed, neighbou
         n_box_lines = k
         for a in range(neighbour_start[c], neighbour_start[c + 1]):
             j = neighbour_index[a]
+            share = 0.5 if priority[c] == priority[j] else (0.0 if priority[c] else 1.0)
             _cone_line(positions[j, 0] - pax, positions[j, 1] - paz, vax - velocities[j, 0], vaz - velocities[j, 1],
-                       ra + radii[j], time_horizon, dt, 0.5, vax, vaz, points, directions, k)
+                       ra + radii[j], time_horizon, dt, share, vax, vaz, points, directions, k)
             k += 1
         result = np.empty(2)
         failed = _plane_program(points, directions, k, speed, preferred[c, 0], preferred[c, 1], False, result)

@@ -15,10 +15,11 @@ TAU = 2.0
 NO_BOXES = (np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), np.zeros((0, 2)), np.zeros(0, np.bool_), np.zeros(0))
 
 
-def _step(pos, vel, pref, radii, vmax, boxes=NO_BOXES, tau=TAU, box_tau=1.0):
+def _step(pos, vel, pref, radii, vmax, boxes=NO_BOXES, tau=TAU, box_tau=1.0, priority=None):
     start, index = neighbour_lists(pos, 10.0)
     out = np.empty_like(pos)
-    orca_velocities(pos, vel, pref, radii, vmax, start, index, *boxes, tau, box_tau, DT, out)
+    priority = np.zeros(len(pos), np.bool_) if priority is None else priority
+    orca_velocities(pos, vel, pref, radii, vmax, start, index, *boxes, tau, box_tau, DT, priority, out)
     return out
 
 
@@ -75,6 +76,20 @@ def test_one_step_against_a_standing_neighbour_equals_the_hand_computed_velocity
     assert out[0] == pytest.approx([7.0 / 8.0, -math.sqrt(3.0) / 8.0], abs=1e-12)
     # B, at rest and preferring rest, takes the other half: v_B + u_B/2 with u_B = -u mirrored.
     assert out[1] == pytest.approx([1.0 / 8.0, math.sqrt(3.0) / 8.0], abs=1e-12)
+
+
+def test_a_character_with_priority_keeps_its_way_and_the_other_takes_the_whole_effort():
+    # The case above with A escaping a crate's lane (priority): A's line passes through v + 0 u, so
+    # its preferred velocity (1, 0) stays; B takes all of -u: (1/4, sqrt(3)/4). Both with priority
+    # share as equals again.
+    pos = np.array([[0.0, 0.0], [2.0, 0.0]])
+    vel = np.array([[1.0, 0.0], [0.0, 0.0]])
+    args = (pos, vel, vel.copy(), np.array([0.5, 0.5]), np.array([2.0, 2.0]))
+    out = _step(*args, priority=np.array([True, False]))
+    assert out[0] == pytest.approx([1.0, 0.0], abs=1e-12)
+    assert out[1] == pytest.approx([1.0 / 4.0, math.sqrt(3.0) / 4.0], abs=1e-12)
+    out = _step(*args, priority=np.array([True, True]))
+    assert out[0] == pytest.approx([7.0 / 8.0, -math.sqrt(3.0) / 8.0], abs=1e-12)
 
 
 def test_a_free_character_keeps_its_preferred_velocity_capped_at_its_top_speed():

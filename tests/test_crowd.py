@@ -413,3 +413,60 @@ def test_a_stance_leg_carried_across_another_leg_steps():
     state.feet[0, [0, 1]] = state.feet[0, [1, 0]]  # back: neither
     stage_ik(model, state, np.ones(1, np.bool_))
     assert not forced()[:2].any()
+
+
+def test_a_turn_is_bounded_by_the_stance_feet_nearest_the_midline():
+    # A quadruped at heading 0 on its four feet, each at 0.3 m ahead of or behind the pelvis and
+    # 0.15 m to its side, all lifting next frame: a turn of a swings a front foot 0.3 a sideways, so
+    # the feet keep STANCE_SIDE_MARGIN x the hip's 0.1 m offset (0.05 m) from the midline for turns
+    # within +-(0.15 - 0.05) / 0.3 = +-1/3 rad. With the left front foot 0.05 m from the midline,
+    # a turn that carries it further is refused (0), the other way it has 0.2 / 0.3.
+    from planner._crowd import STANCE_SIDE_MARGIN, leg_turn_bounds, stance_turn_bounds
+
+    scenario, creature = load_scenario("flat"), load_creature("quadruped")
+    model, state = init_crowd(scenario, creature, load_gait(default_gait_name("quadruped"), creature), n_characters=1,
+                              seed=0, lod_mode="off")
+    assert np.allclose(np.abs(model.hips_body[:, 2]), 0.1) and STANCE_SIDE_MARGIN == 0.5
+    state.heading[:] = 0.0
+    state.in_stance[:] = True
+    state.wants_swing[:] = True  # every foot lifts next frame: the whole room is this frame's
+    body = np.sign(model.hips_body[:, [0, 2]]) * [0.3, 0.15]  # (forward, lateral) = (x, z) at heading 0
+    state.feet[0, :, 0] = state.pelvis[0, 0] + body[:, 0]
+    state.feet[0, :, 2] = state.pelvis[0, 2] + body[:, 1]
+    lo, hi = stance_turn_bounds(model, state)
+    assert np.allclose([lo[0], hi[0]], [-1.0 / 3.0, 1.0 / 3.0])
+    left_front = int(np.flatnonzero((model.hips_body[:, 0] > 0) & (model.hips_body[:, 2] > 0))[0])
+    state.feet[0, left_front, 2] = state.pelvis[0, 2] + 0.05
+    bound = leg_turn_bounds(model, state)[0]
+    assert bound[left_front] == 0.0  # a turn toward positive angles carries it across: none left
+    lo, hi = stance_turn_bounds(model, state)
+    assert hi[0] == 0.0 and np.isclose(lo[0], -1.0 / 3.0)
+    state.in_stance[0, left_front] = False  # a swinging foot bounds nothing
+    assert np.isnan(leg_turn_bounds(model, state)[0, left_front])
+
+
+def test_a_quadruped_turning_back_keeps_its_legs_uncrossed(monkeypatch):
+    # Asked to walk back the way it faces, a quadruped turns on its feet: its front feet, 0.29 m ahead,
+    # would be carried under the body and across each other by a free turn (crossings with the bound
+    # lifted, below); bounded by its stance feet, it turns as it steps and its legs never cross.
+    import planner._crowd as crowd
+
+    from conftest import fresh_seeds
+
+    scenario, creature = load_scenario("flat"), load_creature("quadruped")
+    gait = load_gait(default_gait_name("quadruped"), creature)
+
+    def turn_back(seed):
+        model, state = init_crowd(scenario, creature, gait, n_characters=1, seed=seed, lod_mode="off")
+        start = state.pelvis[0, [0, 2]].copy()
+        state.route[0] = start - (state.route[0] - start)
+        summary = simulate(model, state, 150)
+        return summary, state, start
+
+    for seed in fresh_seeds([0, 1, 2, 3], 1, salt=11):
+        summary, state, start = turn_back(seed)
+        assert summary.leg_crossings == 0, f"seed {seed}"
+        assert abs(abs(state.heading[0]) - math.pi) < 0.2, f"seed {seed}: it turned back"
+    monkeypatch.setattr(crowd, "stance_turn_bounds",
+                        lambda model, state: (np.full(state.heading.shape, -np.inf), np.full(state.heading.shape, np.inf)))
+    assert sum(turn_back(seed)[0].leg_crossings for seed in (0, 1, 2)) > 0, "a free turn must cross legs here"
