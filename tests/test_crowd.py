@@ -460,13 +460,17 @@ def test_a_quadruped_turning_back_keeps_its_legs_uncrossed(monkeypatch):
         model, state = init_crowd(scenario, creature, gait, n_characters=1, seed=seed, lod_mode="off")
         start = state.pelvis[0, [0, 2]].copy()
         state.route[0] = start - (state.route[0] - start)
-        summary = simulate(model, state, 150)
+        summary = simulate(model, state, 200)
         return summary, state, start
 
-    for seed in fresh_seeds([0, 1, 2, 3], 1, salt=11):
+    # 1471968350 (a fresh seed, CI of 8ec1454) paused its turn for 25 frames and faced back only
+    # after 175: the turn is given 200 frames and the facing is measured toward its waypoint.
+    for seed in fresh_seeds([0, 1, 2, 3, 1471968350], 1, salt=11):
         summary, state, start = turn_back(seed)
         assert summary.leg_crossings == 0, f"seed {seed}"
-        assert abs(abs(state.heading[0]) - math.pi) < 0.2, f"seed {seed}: it turned back"
+        to_waypoint = state.route[0, state.route_index[0]] - state.pelvis[0, [0, 2]]
+        off = math.remainder(state.heading[0] - math.atan2(to_waypoint[1], to_waypoint[0]), math.tau)
+        assert abs(off) < 0.1, f"seed {seed}: it did not turn back ({off:+.2f} rad off its waypoint)"
     monkeypatch.setattr(crowd, "stance_turn_bounds",
                         lambda model, state: (np.full(state.heading.shape, -np.inf), np.full(state.heading.shape, np.inf)))
     assert sum(turn_back(seed)[0].leg_crossings for seed in (0, 1, 2)) > 0, "a free turn must cross legs here"
