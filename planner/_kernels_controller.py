@@ -270,3 +270,66 @@ def count_close_pairs(points, owner, radius):
                     if dx * dx + dz * dz < r2:
                         count += 1
     return count
+
+
+@nb.njit(cache=True)
+def _lines_cross_turned(pelvis, heading, hips_body, feet, c, i, j):
+    """Legs i and j of character c, the body at ``heading``: their ground lines (hip to foot, the
+    hips swung with the body about the pelvis) cross properly."""
+    co = math.cos(heading)
+    si = math.sin(heading)
+    ix = pelvis[c, 0] + hips_body[i, 0] * co - hips_body[i, 2] * si
+    iz = pelvis[c, 2] + hips_body[i, 0] * si + hips_body[i, 2] * co
+    jx = pelvis[c, 0] + hips_body[j, 0] * co - hips_body[j, 2] * si
+    jz = pelvis[c, 2] + hips_body[j, 0] * si + hips_body[j, 2] * co
+    return segments_cross(ix, iz, feet[c, i, 0], feet[c, i, 2], jx, jz, feet[c, j, 0], feet[c, j, 2])
+
+
+@nb.njit(cache=True)
+def _pair_newly_crossed(pelvis, heading, turn, hips_body, feet, c, i, j):
+    """Legs i and j of character c cross with the body turned by ``turn`` from ``heading`` and not at it."""
+    return (_lines_cross_turned(pelvis, heading + turn, hips_body, feet, c, i, j)
+            and not _lines_cross_turned(pelvis, heading, hips_body, feet, c, i, j))
+
+
+@nb.njit(cache=True)
+def _turn_crosses(pelvis, heading, turn, hips_body, feet, legs, c):
+    """Some pair of character c's ``legs`` is newly crossed by ``turn`` (:func:`_pair_newly_crossed`)."""
+    n_legs = feet.shape[1]
+    for i in range(n_legs):
+        for j in range(i + 1, n_legs):
+            if legs[c, i] and legs[c, j] and _pair_newly_crossed(pelvis, heading[c], turn, hips_body, feet, c, i, j):
+                return True
+    return False
+
+
+@nb.njit(cache=True, parallel=True)
+def uncrossed_turns(pelvis, heading, turn, hips_body, feet, legs, out):
+    """Per character, ``turn`` kept, halved or dropped (the first that crosses no pair of ``legs``
+    that did not cross before: :func:`_turn_crosses`; ``feet`` where each leg stands or lands)."""
+    for c in nb.prange(pelvis.shape[0]):
+        out[c] = turn[c]
+        if turn[c] == 0.0:
+            continue
+        if _turn_crosses(pelvis, heading, turn[c], hips_body, feet, legs, c):
+            out[c] = 0.5 * turn[c]
+            if _turn_crosses(pelvis, heading, out[c], hips_body, feet, legs, c):
+                out[c] = 0.0
+
+
+@nb.njit(cache=True, parallel=True)
+def legs_crossed_by_turn(pelvis, heading, turn, hips_body, feet, legs, out):
+    """Per character and leg, a leg of ``legs`` whose ground line would cross another's with the
+    body turned by ``turn`` (C,), and did not before."""
+    n_legs = feet.shape[1]
+    for c in nb.prange(pelvis.shape[0]):
+        for i in range(n_legs):
+            out[c, i] = False
+        if turn[c] == 0.0:
+            continue
+        for i in range(n_legs):
+            for j in range(i + 1, n_legs):
+                if legs[c, i] and legs[c, j] and _pair_newly_crossed(pelvis, heading[c], turn[c], hips_body, feet,
+                                                                     c, i, j):
+                    out[c, i] = True
+                    out[c, j] = True

@@ -445,6 +445,54 @@ def test_a_turn_is_bounded_by_the_stance_feet_nearest_the_midline():
     assert np.isnan(leg_turn_bounds(model, state)[0, left_front])
 
 
+def test_a_turn_that_would_carry_a_stance_leg_across_another_is_halved_then_refused():
+    # A quadruped at the origin, heading 0: hips (+-0.27, +-0.1). Its left front foot stands at
+    # (0, 0.4), its left hind foot at (0.1, 0.25), ahead of the hind hip: the two legs' ground lines
+    # (hip to foot) do not cross. Turning right (negative angles) swings the front hip out and back
+    # until the front leg's line sweeps over the hind foot: at the angle a* where the hind foot lies on
+    # it (worked out below with a plain cross product, by bisection), the legs cross from then on.
+    from planner._crowd import turn_crossed_legs, uncrossing_turn
+
+    scenario, creature = load_scenario("flat"), load_creature("quadruped")
+    model, state = init_crowd(scenario, creature, load_gait(default_gait_name("quadruped"), creature), n_characters=1,
+                              seed=0, lod_mode="off")
+    np.testing.assert_allclose(np.abs(model.hips_body[:, [0, 2]]), [[0.27, 0.1]] * 4)
+    state.heading[:] = 0.0
+    state.pelvis[0, [0, 2]] = 0.0
+    state.in_stance[:] = True
+    front = int(np.flatnonzero((model.hips_body[:, 0] > 0) & (model.hips_body[:, 2] > 0))[0])
+    hind = int(np.flatnonzero((model.hips_body[:, 0] < 0) & (model.hips_body[:, 2] > 0))[0])
+    state.feet[0, :, [0, 2]] = (np.sign(model.hips_body[:, [0, 2]]) * [0.3, 0.15]).T
+    state.feet[0, front, [0, 2]] = [0.0, 0.4]
+    state.feet[0, hind, [0, 2]] = [0.1, 0.25]
+
+    def side(a):  # the hind foot's side of the front leg's line, the body turned by a
+        hx, hz = 0.27 * math.cos(a) - 0.1 * math.sin(a), 0.27 * math.sin(a) + 0.1 * math.cos(a)
+        return (0.0 - hx) * (0.25 - hz) - (0.4 - hz) * (0.1 - hx)
+
+    lo, hi = -0.6, 0.0
+    assert side(lo) * side(hi) < 0.0
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if side(mid) * side(lo) > 0.0 else (lo, mid)
+    a_star = 0.5 * (lo + hi)  # -0.4545... rad
+    assert -0.5 < a_star < -0.4
+
+    def crossed(a):  # stance legs newly crossed by a turn of a from heading 0
+        return turn_crossed_legs(model, state, np.array([a]))[0]
+
+    assert not crossed(0.0).any() and not crossed(a_star + 0.01).any()
+    np.testing.assert_array_equal(np.flatnonzero(crossed(a_star - 0.01)), sorted([front, hind]))
+    # A turn short of a* is kept; one past it is halved (-0.25 does not reach a*) ...
+    assert uncrossing_turn(model, state, np.array([-0.3]))[0] == -0.3
+    assert uncrossing_turn(model, state, np.array([-0.5]))[0] == -0.25
+    assert uncrossing_turn(model, state, np.array([0.5]))[0] == 0.5
+    # ... and refused when half of it is past a* too (the body at -0.4 already).
+    state.heading[:] = -0.4
+    assert uncrossing_turn(model, state, np.array([-0.2]))[0] == 0.0
+    assert uncrossing_turn(model, state, np.array([-0.04]))[0] == -0.04
+
+
 def test_a_quadruped_turning_back_keeps_its_legs_uncrossed(monkeypatch):
     # Asked to walk back the way it faces, a quadruped turns on its feet: its front feet, 0.29 m ahead,
     # would be carried under the body and across each other by a free turn (crossings with the bound

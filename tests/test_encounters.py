@@ -255,3 +255,67 @@ def test_a_character_in_a_crates_lane_heads_square_out_of_it_to_the_nearer_side(
         assert in_lane[0] == (expected != [1.0, 0.0])
     state.pelvis[0, [0, 2]] = [2.0, 0.0]  # behind the crate
     assert not lane_exit(model, state, way)[1][0]
+
+
+def test_a_foot_a_wide_crate_leaves_no_footprint_is_tucked_out_of_its_way(tmp_path, monkeypatch):
+    # A spider stands at its goal (0, 0) facing +x. A 0.6 m crate slides +x at 0.2 m/s along z = 0.45:
+    # it covers z 0.15..0.75, the left feet's spots (about 0.3 m to the left) and their candidate discs
+    # (0.25 m about the same spots, down to z 0.05), but not the body. The left feet have nowhere to
+    # step: each is tucked up near its hip (planner._crowd.tuck_swings, a quarter of its rest offset
+    # out, z about 0.1) until the crate has passed, and lands again behind it.
+    import planner._crowd as crowd
+
+    def run():
+        model, state = _world(tmp_path, "tuck", crate_centre=(-1.8, 0.45), crate_width=0.6, start=(0.0, 0.0),
+                              goal=(0.0, 0.0), velocity=(0.2, 0.0))
+        inside, tucked = [], []
+
+        def check(s):
+            c, h, y = _crate_now(model, s.t)
+            feet = np.where(s.ik_on[0], s.fk_feet[0], s.feet[0])
+            inside.append(int(_inside(feet[:, [0, 2]], c, h, y).sum()))
+            tucked.append(s.tucked[0].copy())
+
+        counters = _run(model, state, 540, check)
+        assert _crate_now(model, state.t)[0][0] - 0.3 > 0.5, "the crate must pass the spider"
+        return sum(inside), np.array(tucked), counters, state
+
+    inside, tucked, counters, state = run()
+    assert tucked[:, state.feet[0, :, 2] > 0.2].any(), "a left foot must have been tucked"
+    assert not tucked[:, state.feet[0, :, 2] < -0.2].any(), "no right foot is in the crate's way"
+    assert inside == 0
+    assert state.in_stance[0].all() and not state.tucked[0].any(), "every foot lands again"
+    assert counters.leg_crossings == 0
+    assert counters.max_stance_slip_m <= 1e-3
+    # Left in place (the hold it replaced), the same feet stand under the crate.
+    monkeypatch.setattr(crowd, "tuck_swings", lambda *args: None)
+    assert run()[0] > 0, "without the tuck the crate must run over a foot here"
+
+
+def test_a_tucked_foot_rises_first_then_moves_in_to_its_tuck_point(tmp_path):
+    from planner._crowd import TUCK_LIFT, TUCK_REACH, hips_world, tuck_points, tuck_swings
+
+    model, state = _world(tmp_path, "tuck-point", crate_centre=(5.0, 5.0), crate_width=0.2, start=(0.0, 0.0),
+                          goal=(4.0, 0.0))
+    hips = hips_world(model, state)
+    legs = np.array([0, 3])
+    chars = np.zeros(2, np.int64)
+    point = tuck_points(model, state, chars, legs, hips)
+    rest = model.rest_body[legs]
+    # Heading 0: body forward is +x and left is +z; the point is a quarter of the way from the hip
+    # to the rest foot on the ground, halfway between the ground and the hip in height.
+    np.testing.assert_allclose(point[:, 0], hips[0, legs, 0] + TUCK_REACH * (rest[:, 0] - model.hips_body[legs, 0]))
+    np.testing.assert_allclose(point[:, 2], hips[0, legs, 2] + TUCK_REACH * (rest[:, 1] - model.hips_body[legs, 2]))
+    height = model.creature.standing_height + model.hips_body[legs, 1]
+    np.testing.assert_allclose(point[:, 1], hips[0, legs, 1] - (1.0 - TUCK_LIFT) * height)
+    source = state.feet[0, legs].copy()
+    tuck_swings(model, state, chars, legs, hips, np.full(2, 0.01))
+    path = state.trajectories[0, legs]
+    k = path.shape[1]
+    np.testing.assert_allclose(path[:, 0], source)
+    np.testing.assert_allclose(path[:, -1], point)
+    third = int(np.ceil((k - 1) / 3.0))  # the first sample at or past a third of the way: risen
+    np.testing.assert_allclose(path[:, third, 1], point[:, 1])
+    assert (np.abs(path[:, third, [0, 2]] - source[:, [0, 2]]) < np.abs(point[:, [0, 2]] - source[:, [0, 2]])).all()
+    assert state.tucked[0, legs].all() and not state.in_stance[0, legs].any()
+    assert (state.swing_T[0, legs] == 3.0 * model.dt).all(), "a tuck lasts at least three frames: it never lands"
