@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 
 def recorded_run(scenario, creature, gait, *, frames: int, characters: int | None = None, seed: int = 0,
                  preset=None, lod: str = "off", record: bool = True, progress=None):
@@ -54,7 +56,10 @@ def load_named_preset(value: str, creature: str):
 
 def recording_meta(scenario, seed: int, lod: str, gait) -> dict:
     """What a recording's header says about its run, beside the recorder's own fields."""
-    return {"scenario": scenario.name, "seed": int(seed), "lod": lod, "gait": gait.name}
+    meta = {"scenario": scenario.name, "seed": int(seed), "lod": lod, "gait": gait.name}
+    if not scenario.source.startswith("builtin:"):  # a user's scenario file: where to find it again
+        meta["scenario_file"] = str(Path(scenario.source).resolve())
+    return meta
 
 
 def resolve_gait(scenario, creature, option: str | None = None):

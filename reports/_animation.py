@@ -212,14 +212,12 @@ def render_stills(scene: dict, out_dir, regions=None, size: tuple[int, int] | No
 
 
 def run_scene(run, frames: int | None = None, max_characters: int | None = MAX_DRAWN_CHARACTERS) -> dict:
-    """The scene of the first ``frames`` frames of a loaded recording, its scenario looked up by name
-    and its creature by name or from the creature file it carries (an :class:`InputError` when one is
-    not at hand)."""
-    from scenarios import load_scenario
-
+    """The scene of the first ``frames`` frames of a loaded recording, its scenario from the file it
+    was run from or by name (:meth:`Recording.load_scenario`) and its creature by name or from the
+    creature file it carries (an :class:`InputError` when one is not at hand)."""
     if frames is not None:
         run = run.head(frames)
-    return recording_scene(run, load_scenario(run.scenario), run.load_creature(), max_characters)
+    return recording_scene(run, run.load_scenario(), run.load_creature(), max_characters)
 
 
 def recording_clip_scene(recording_path, frames: int | None = None,

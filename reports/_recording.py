@@ -98,6 +98,16 @@ class Recording:
         name = self.header.get("scenario")
         return None if name is None else str(name)
 
+    def load_scenario(self):
+        """The recorded scenario: the user's scenario file it was run from, while that file is where
+        it was (its height maps and creature files are found relative to it), else a built-in by name."""
+        from scenarios import load_scenario
+
+        file = self.header.get("scenario_file")
+        if isinstance(file, str) and Path(file).is_file():
+            return load_scenario(file)
+        return load_scenario(self.scenario)
+
     def event_column(self, name: str) -> np.ndarray:
         """(E,) one column of the events table, by its header name."""
         return self.events[:, list(self.header["event_columns"]).index(name)]

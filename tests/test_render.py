@@ -152,3 +152,21 @@ def test_a_failing_renderer_is_one_line(tmp_path):
         run_renderer(["clip", str(tmp_path / "no-scene.npz"), str(tmp_path / "x.mp4")], timeout=120)
     message = str(failure.value)
     assert "\n" not in message and message.startswith("the renderer exited with code 1: ") and "no-scene" in message
+
+
+def test_a_recording_of_a_scenario_file_finds_its_scenario_again(tmp_path):
+    # `footfall render my.toml` simulated, then looked the scenario up by its name ("unknown scenario"):
+    # a recording of a user's scenario file carries the file's path, and its scene is built from it.
+    from reports._animation import recording_clip_scene
+    from reports._recording import load_recording
+
+    scenario = tmp_path / "my-walk.toml"  # a name no built-in has
+    scenario.write_text('name = "my-walk"\nseed = 0\n[terrain]\nkind = "flat"\nsize = [6.0, 6.0]\ncell_size = 0.05\n'
+                        '[crowd]\ncreature = "spider"\ncentre = [0.0, 0.0]\nheading = 0.0\nspeed = 0.2\n'
+                        'goal = [1.0, 0.0]\n')
+    path = tmp_path / "walk.npz"
+    result = footfall_cli("simulate", scenario, "--frames", "60", "--record", path, "--json")
+    assert result.returncode == 0, result.stderr
+    run = load_recording(path)
+    assert run.load_scenario().source == str(scenario.resolve())
+    assert recording_clip_scene(path)  # built (it raised "unknown scenario")
