@@ -545,10 +545,12 @@ def resume_frequency(model: CrowdModel, state: CrowdState) -> np.ndarray:
     return _stride_frequency(model.timing, np.minimum(state.desired_speed, state.speed_limit), model.leg_height)
 
 
-def leg_speed_caps(model: CrowdModel, state: CrowdState) -> np.ndarray:
-    """(C, L) the fastest the body may move for each stance foot (inf for swinging feet)."""
-    room = stance_room(model, state)
-    return np.where(state.in_stance, np.maximum(room, 0.0) / until_lift(model, state), np.inf)
+def leg_speed_caps(model: CrowdModel, state: CrowdState, room=None, lift=None) -> np.ndarray:
+    """(C, L) the fastest the body may move for each stance foot (inf for swinging feet); ``room``
+    (:func:`stance_room`) and ``lift`` (:func:`until_lift`) of this state if the caller has them."""
+    room = stance_room(model, state) if room is None else room
+    lift = until_lift(model, state) if lift is None else lift
+    return np.where(state.in_stance, np.maximum(room, 0.0) / lift, np.inf)
 
 
 def until_lift(model: CrowdModel, state: CrowdState) -> np.ndarray:
@@ -571,7 +573,7 @@ STANCE_SIDE_MARGIN = 0.5
 while the body turns (:func:`stance_turn_bounds`)."""
 
 
-def leg_turn_bounds(model: CrowdModel, state: CrowdState) -> np.ndarray:
+def leg_turn_bounds(model: CrowdModel, state: CrowdState, lift=None) -> np.ndarray:
     """(C, L) rad: how far each body may turn this frame, toward the side its turn bound is on (its
     sign), so that the stance foot is not carried across the midline (to within
     ``STANCE_SIDE_MARGIN``) before the needle lifts it; ``nan`` where the foot gives no bound.
@@ -580,8 +582,9 @@ def leg_turn_bounds(model: CrowdModel, state: CrowdState) -> np.ndarray:
     the body's frame: a quadruped's front feet, 0.29 m ahead, cross under the body after 0.4 rad, and
     its legs cross. Each stance foot gives the room it has to its margin, spread over the time until
     it lifts (as :func:`leg_speed_caps` does for the speed); swinging feet and legs on the midline
-    give no bound.
+    give no bound. ``lift``: :func:`until_lift` of this state if the caller has it.
     """
+    lift = until_lift(model, state) if lift is None else lift
     side = np.sign(model.hips_body[:, 2]) * (np.abs(model.hips_body[:, 2]) > 1e-3 * model.rest_radius)
     margin = STANCE_SIDE_MARGIN * np.abs(model.hips_body[:, 2])
     cos, sin = np.cos(state.heading)[:, None], np.sin(state.heading)[:, None]
@@ -589,7 +592,7 @@ def leg_turn_bounds(model: CrowdModel, state: CrowdState) -> np.ndarray:
     forward = d[..., 0] * cos + d[..., 1] * sin
     lateral = -d[..., 0] * sin + d[..., 1] * cos
     # Turning by a moves the foot's lateral coordinate by about -forward * a (a small).
-    room = np.maximum(side * lateral - margin, 0.0) * model.dt / until_lift(model, state)
+    room = np.maximum(side * lateral - margin, 0.0) * model.dt / lift
     lever = side * forward
     bounded = state.in_stance & (side != 0.0) & (np.abs(lever) > 1e-9)
     return np.where(bounded, room / np.where(bounded, lever, 1.0), np.nan)
@@ -618,7 +621,7 @@ def uncrossing_turn(model: CrowdModel, state: CrowdState, turn) -> np.ndarray:
     (:func:`turn_crossed_legs`, ``stage_requests``) and the turn goes on."""
     out = np.empty(state.heading.shape, dtype=np.float64)
     uncrossed_turns(state.pelvis, state.heading, np.ascontiguousarray(turn, dtype=np.float64), model.hips_body,
-                    _landing_feet(state), np.ones_like(state.in_stance), out)
+                    _landing_feet(state), out)
     return out
 
 
@@ -871,10 +874,11 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, fre
     # A stance foot that holds the body under half its goal speed (stance_speed_cap) steps now too:
     # waiting for its sector, with the body slow and the needle slower, would freeze the walk.
     goal = np.minimum(state.desired_speed, state.speed_limit)[:, None]
-    far |= cannot_follow | (stance_room(model, state) <= 0.0) | (leg_speed_caps(model, state) < 0.5 * goal)
+    room, lift = stance_room(model, state), until_lift(model, state)
+    far |= cannot_follow | (room <= 0.0) | (leg_speed_caps(model, state, room, lift) < 0.5 * goal)
     # So does a stance foot that stops the body's turn (stance_turn_bounds: no room left), or holds the
     # turn of a slow body under half the turn asked: a body turning on the spot turns by stepping.
-    bound, wanted = leg_turn_bounds(model, state), state.turn_wanted[:, None]
+    bound, wanted = leg_turn_bounds(model, state, lift), state.turn_wanted[:, None]
     holds_turn = (np.signbit(bound) == (wanted < 0.0)) & ~np.isnan(bound) & (wanted != 0.0)
     far |= holds_turn & ((bound == 0.0) | ((np.abs(bound) < 0.5 * np.abs(wanted)) & ~walking[:, None]))
     # So does a stance leg the turn asked would carry across another (uncrossing_turn holds the turn).

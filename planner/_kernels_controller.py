@@ -293,27 +293,27 @@ def _pair_newly_crossed(pelvis, heading, turn, hips_body, feet, c, i, j):
 
 
 @nb.njit(cache=True)
-def _turn_crosses(pelvis, heading, turn, hips_body, feet, legs, c):
-    """Some pair of character c's ``legs`` is newly crossed by ``turn`` (:func:`_pair_newly_crossed`)."""
+def _turn_crosses(pelvis, heading, turn, hips_body, feet, c):
+    """Some pair of character c's legs is newly crossed by ``turn`` (:func:`_pair_newly_crossed`)."""
     n_legs = feet.shape[1]
     for i in range(n_legs):
         for j in range(i + 1, n_legs):
-            if legs[c, i] and legs[c, j] and _pair_newly_crossed(pelvis, heading[c], turn, hips_body, feet, c, i, j):
+            if _pair_newly_crossed(pelvis, heading[c], turn, hips_body, feet, c, i, j):
                 return True
     return False
 
 
 @nb.njit(cache=True, parallel=True)
-def uncrossed_turns(pelvis, heading, turn, hips_body, feet, legs, out):
-    """Per character, ``turn`` kept, halved or dropped (the first that crosses no pair of ``legs``
-    that did not cross before: :func:`_turn_crosses`; ``feet`` where each leg stands or lands)."""
+def uncrossed_turns(pelvis, heading, turn, hips_body, feet, out):
+    """Per character, ``turn`` kept, halved or dropped (the first that crosses no pair of legs that
+    did not cross before: :func:`_turn_crosses`; ``feet`` where each leg stands or lands)."""
     for c in nb.prange(pelvis.shape[0]):
         out[c] = turn[c]
         if turn[c] == 0.0:
             continue
-        if _turn_crosses(pelvis, heading, turn[c], hips_body, feet, legs, c):
+        if _turn_crosses(pelvis, heading, turn[c], hips_body, feet, c):
             out[c] = 0.5 * turn[c]
-            if _turn_crosses(pelvis, heading, out[c], hips_body, feet, legs, c):
+            if _turn_crosses(pelvis, heading, out[c], hips_body, feet, c):
                 out[c] = 0.0
 
 

@@ -181,17 +181,21 @@ def _wrap_pi(x):
     return (x + math.pi) % TWO_PI - math.pi
 
 
+@nb.njit(cache=True, inline="always")
+def _across(df, dl, alpha):
+    """The target's horizontal coordinate to the left of the direction ``alpha`` (body frame)."""
+    return -df * math.sin(alpha) + dl * math.cos(alpha)
+
+
 @nb.njit(cache=True)
 def _in_plane_target(df, du, dl, alpha, q_plane, rolls):
     """Target (outward, up, normal) coordinates in the leg plane at plane angle ``q_plane``
     (rest azimuth ``alpha``; ``rolls``: the plane rolls about its outward axis, module docstring)."""
     if rolls:
-        ca = math.cos(alpha)
-        sa = math.sin(alpha)
-        side = -df * sa + dl * ca
+        side = _across(df, dl, alpha)
         cr = math.cos(q_plane)
         sr = math.sin(q_plane)
-        return df * ca + dl * sa, du * cr + side * sr, -du * sr + side * cr
+        return df * math.cos(alpha) + dl * math.sin(alpha), du * cr + side * sr, -du * sr + side * cr
     beta = alpha + q_plane
     cb = math.cos(beta)
     sb = math.sin(beta)
@@ -257,7 +261,7 @@ def _azimuth_for(fx, fy, q_az, df, du, dl, alpha, azimuth_limit, rolls):
     """Exact single-joint step of the plane joint, clamped: the leg plane towards the target (away if
     fx < 0); a rolling plane through the target, the foot on its side of the hip (below if fy < 0)."""
     if rolls:
-        side = -df * math.sin(alpha) + dl * math.cos(alpha)
+        side = _across(df, dl, alpha)
         if math.hypot(du, side) < EPS or abs(fy) < EPS:
             return q_az
         want = math.atan2(-side, -du)

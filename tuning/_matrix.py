@@ -200,12 +200,13 @@ def run_matrix(presets_dir: str | Path, names=None, runs: int = RUNS, terrains=N
             cells[terrain] = evaluate_cell(defaults[key], mine, style)
         w0 = ScoringWeights().to_array()
         w = preset.weights.to_array()
-        passes, why = verdict(name, cells, style, float(np.max(np.abs(w / w0 - 1.0))))
+        change = float(np.max(np.abs(w / w0 - 1.0)))
+        passes, why = verdict(name, cells, style, change)
         out["presets"][name] = {
             "found": True, "creature": creature, "kind": "terrain" if "terrain" in spec else "style",
             "for": spec.get("terrain") or list(spec["terrains"]), "style": style, "command": spec["command"],
             "sha256": hashlib.sha256(path.read_bytes()).hexdigest(),
-            "weights_max_rel_change": float(np.max(np.abs(w / w0 - 1.0))),
+            "weights_max_rel_change": change,
             "passes": passes, "why": why, "cells": cells}
     return _clean(out)
 
