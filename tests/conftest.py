@@ -51,6 +51,28 @@ def pytest_report_header(config):
     return f"footfall fresh seeds: FOOTFALL_TEST_SEED={_SESSION_SEED} (set it to replay this session's draw)"
 
 
+# --------------------------------------------------------------------------- one compile of the kernels
+# On a cold numba cache (a fresh clone) the crowd runtime's kernels take about a minute of one core
+# to compile, and every process that meets them cold compiles them itself: both xdist workers at once,
+# and every CLI subprocess a test starts meanwhile (on 2 cores, 2.8 compiles' worth of CPU: the suite
+# took 5:14 on a fresh clone against 3:48 warm). So the controller compiles them once, in a short
+# run, before it starts the workers; warm, this run costs about 3 s.
+@pytest.hookimpl(tryfirst=True)
+def pytest_sessionstart(session):
+    import subprocess
+    import sys
+
+    if os.environ.get("PYTEST_XDIST_WORKER") or session.config.getoption("collectonly", False):
+        return
+    started = time.perf_counter()
+    proc = subprocess.run([sys.executable, "-m", "footfall.cli", "simulate", "mixed", "--frames", "3",
+                           "--characters", "4", "--json"], capture_output=True, text=True, timeout=900)
+    if proc.returncode != 0:  # the tests will say what is wrong, one by one
+        print(f"footfall: the kernels' warm-up run failed ({proc.stderr.strip().splitlines()[-1:]})")
+    elif time.perf_counter() - started > 10:
+        print(f"footfall: compiled the numba kernels once ({time.perf_counter() - started:.0f} s)")
+
+
 def fresh_seeds(fixed, n_fresh, *, salt=0):
     """``fixed`` seeds followed by ``n_fresh`` seeds drawn for this session (in [1000, 2**31))."""
     import numpy as np
