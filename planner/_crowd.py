@@ -732,9 +732,11 @@ def _foot_room(model: CrowdModel) -> float:
 
 def _same_frame_conflicts(model: CrowdModel, cs, targets, valid) -> np.ndarray:
     """(F,) bool: valid plans whose target lies within a foot's room of an earlier valid plan's target
-    of another character (this frame's plans)."""
+    (this frame's plans): of another character, or of the same one (two legs of a character planned
+    in one frame do not see each other's targets either: a spider's adjacent rear legs landed on one
+    spot and crossed, crates, seed 200)."""
     conflict = np.zeros(cs.size, dtype=np.bool_)
-    if not model.controller.avoid_others_feet or np.unique(cs[valid]).size < 2:
+    if np.count_nonzero(valid) < 2:
         return conflict
     from scipy.spatial import cKDTree
 
@@ -743,8 +745,8 @@ def _same_frame_conflicts(model: CrowdModel, cs, targets, valid) -> np.ndarray:
     pairs = cKDTree(targets[idx][:, [0, 2]]).query_pairs(radius, output_type="ndarray")
     if pairs.size:
         a, b = idx[pairs[:, 0]], idx[pairs[:, 1]]
-        other = cs[a] != cs[b]
-        conflict[np.maximum(a, b)[other]] = True
+        counted = (cs[a] == cs[b]) | model.controller.avoid_others_feet
+        conflict[np.maximum(a, b)[counted]] = True
     return conflict
 
 

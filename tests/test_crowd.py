@@ -385,6 +385,38 @@ def test_a_crowds_feet_keep_a_foots_room_from_each_other():
     assert counts[False] > 0, "the run must bring feet of different characters together"
 
 
+def test_two_feet_planned_in_one_frame_never_share_a_spot_whether_of_one_character_or_two():
+    """Feet planned in the same frame do not see each other's targets: of two valid plans whose
+    targets lie within a foot's room, the later one (in plan order) waits a frame. That holds for two
+    legs of one character as for two characters (a spider's adjacent rear legs landed on one spot
+    and their legs crossed, crates, seed 200)."""
+    import dataclasses
+
+    from planner._crowd import _foot_room, _same_frame_conflicts
+
+    scenario, creature = load_scenario("flat"), load_creature("spider")
+    model, _ = init_crowd(scenario, creature, load_gait(default_gait_name("spider"), creature), n_characters=2,
+                          seed=0, lod_mode="off", raster=_raster(scenario, creature))
+    room = _foot_room(model)
+    # plans: 0 and 1 are character 0's, 2 is character 1's, 3 is character 0's again but far away.
+    cs = np.array([0, 0, 1, 0])
+    targets = np.array([[0.0, 0.0, 0.0], [0.5 * room, 0.0, 0.0], [0.0, 0.0, 0.9 * room], [1.0, 0.0, 1.0]])
+    valid = np.array([True, True, True, True])
+    # 1 is within a foot's room of 0 (same character), 2 within it of 0 and 1 (another character).
+    assert _same_frame_conflicts(model, cs, targets, valid).tolist() == [False, True, True, False]
+    # An invalid plan conflicts with nothing: with 0 invalid, 1 and 2 are free (1.03 rooms apart).
+    assert _same_frame_conflicts(model, cs, targets, np.array([False, True, True, True])).tolist() == [
+        False, False, False, False]
+    # Without avoiding other characters' feet, only the same character's pair counts.
+    alone = dataclasses.replace(model, controller=dataclasses.replace(model.controller, avoid_others_feet=False))
+    assert _same_frame_conflicts(alone, cs, targets, valid).tolist() == [False, True, False, False]
+    # Just outside a foot's room: no conflict.
+    apart = targets.copy()
+    apart[1, 0] = 1.01 * room
+    apart[2, 2] = 1.01 * np.hypot(room, room)
+    assert _same_frame_conflicts(model, cs, apart, valid).tolist() == [False, False, False, False]
+
+
 def test_a_stance_leg_carried_across_another_leg_steps():
     # Two neighbouring stance feet of a standing spider swapped (as a body turning over its feet
     # carries them): their drawn legs cross, and the controller asks both to step now (kind 2, a
