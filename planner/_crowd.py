@@ -918,6 +918,17 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, fre
         room = model.n_legs // 2 - (~state.in_stance).sum(axis=1) - (kinds == 1).sum(axis=1)
         # A foot about to be hit by a moving box lifts even past that limit.
         kinds[forced & ((rank < room[:, None]) | threatened)] = 2
+        # A foot the body waits for (its leg cannot follow it) that found no room goes before the
+        # gait's own swings: they wait, and the next landing makes room for it. Otherwise the other
+        # legs stepped in turn on the spot, two in the air at any time, while the body waited for
+        # good (robot5 over a low crate, crates-moving seed 0: 192 frames with a foot inside it).
+        # Only where that makes room (a frame with no leg to spare changes nothing by waiting).
+        spare = model.n_legs // 2 - (~state.in_stance).sum(axis=1)
+        starved = (cannot_follow & forced & (kinds == 0)).any(axis=1) & (spare > 0)
+        if starved.any():
+            kinds[starved[:, None] & (kinds == 1) & ~far] = 0  # a foot that must step anyway steps
+            room = spare - (kinds == 1).sum(axis=1)
+            kinds[forced & (rank < room[:, None])] = 2
     held = (cannot_follow & (kinds == 0)).any(axis=1)
     # Held from this frame on: take back this frame's move (the pelvis pose stays too).
     newly = held & ~state.body_held

@@ -252,18 +252,9 @@ def test_a_stance_foot_whose_leg_lost_it_steps_next_frame():
     """A pose taken back because a stance leg lost its foot (``unfollowed``) makes that foot step in
     the next requests, even though the look-ahead from the held body finds it reachable again: the
     body stood, moved, lost the foot and stood again, for good, while a crate ran over it."""
-    from planner._crowd import ControllerConfig, stage_requests, step
+    from planner._crowd import stage_requests
 
-    scenario, creature = load_scenario("flat"), load_creature("ant")
-    model, state = init_crowd(scenario, creature, load_gait(default_gait_name("ant"), creature), n_characters=1,
-                              seed=0, lod_mode="off", raster=_raster(scenario, creature), controller=ControllerConfig())
-    for _ in range(30):
-        step(model, state)
-    state.in_stance[0] = True
-    state.wants_swing[0] = False
-    state.sector_missed[0] = False
-    state.speed[0] = 0.0  # held: the look-ahead finds every foot reachable
-    args = (np.zeros_like(state.in_stance), _no_boxes(), hips_world(model, state), np.array([1e-6]))
+    model, state, args = _standing_on_flat("ant")
     before = (state.cannot_follow.copy(), state.unfollowed.copy())
     assert not (stage_requests(model, state, *args)[0] == 2).any()
     state.cannot_follow[:], state.unfollowed[:] = before
@@ -271,6 +262,56 @@ def test_a_stance_foot_whose_leg_lost_it_steps_next_frame():
     kinds = stage_requests(model, state, *args)
     assert kinds[0, 3] == 2 and (kinds[0] == 2).sum() == 1
     assert not state.body_held[0]
+
+
+def test_a_foot_the_body_waits_for_goes_before_the_gaits_own_swings():
+    """A stance foot its leg lost (the body waits for it) steps before the gait lifts another leg:
+    with one of robot5's five legs in the air and the gait asking for a second, only two may be up
+    at once, so the lost foot found no room, frame after frame, while the other legs stepped in turn
+    on the spot and the body waited for good (crates-moving, seed 0: 192 frames, a foot inside a
+    crate). With no leg to spare (two in the air), nothing changes: the gait's swing goes."""
+    from planner._crowd import stage_requests
+
+    model, state, args = _standing_on_flat("robot5")
+    saved = {k: getattr(state, k).copy() for k in ("cannot_follow", "unfollowed", "wants_swing", "in_stance",
+                                                   "body_held", "speed_limit", "pelvis")}
+
+    def requests(swinging, gait_asks, lost):
+        for k, v in saved.items():
+            getattr(state, k)[:] = v
+        state.in_stance[0, swinging] = False
+        state.wants_swing[0, gait_asks] = True
+        state.unfollowed[0, lost] = True
+        kinds = stage_requests(model, state, *args)[0]
+        # the stance legs' requests (a leg in the air may be re-planned, kind 3: not what is checked)
+        return [int(k) if state.in_stance[0, leg] else None for leg, k in enumerate(kinds)]
+
+    assert requests([], [], []) == [0, 0, 0, 0, 0]  # nothing asked: the check sees only what is set below
+    # one leg up (0), the gait asks for leg 2, leg 3 is lost: leg 3 steps, leg 2 waits, the body moves
+    assert requests([0], [2], [3]) == [None, 0, 0, 2, 0]
+    assert not state.body_held[0]
+    assert state.wants_swing[0, 2]  # still wanted: it goes at the next landing
+    # two legs up (0, 1): no room either way; the gait's swing goes and the body waits
+    assert requests([0, 1], [2], [3]) == [None, None, 1, 0, 0]
+    assert state.body_held[0]
+
+
+def _standing_on_flat(creature_name):
+    """(model, state, stage_requests' other arguments) of one character on ``flat`` after 30 frames,
+    every foot put down, standing (speed 0: the look-ahead finds every foot reachable), nothing asked."""
+    from planner._crowd import ControllerConfig, step
+
+    scenario, creature = load_scenario("flat"), load_creature(creature_name)
+    model, state = init_crowd(scenario, creature, load_gait(default_gait_name(creature_name), creature),
+                              n_characters=1, seed=0, lod_mode="off", raster=_raster(scenario, creature),
+                              controller=ControllerConfig())
+    for _ in range(30):
+        step(model, state)
+    state.in_stance[0] = True
+    state.wants_swing[0] = False
+    state.sector_missed[0] = False
+    state.speed[0] = 0.0
+    return model, state, (np.zeros_like(state.in_stance), _no_boxes(), hips_world(model, state), np.array([1e-6]))
 
 
 def _no_boxes():
