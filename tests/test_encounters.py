@@ -189,6 +189,33 @@ def test_a_spider_steered_straight_at_a_forbidden_crate_passes_around_it(tmp_pat
     assert state.pelvis[0, 0] > 0.5, "the spider got past the crate"
 
 
+def test_avoidance_keeps_a_forbidden_crate_clear_of_the_body_for_its_horizon(tmp_path):
+    # ORCA against a box (van den Berg et al. 2011; planner/_kernels_avoidance.py): the box is seen as its
+    # nearest point, and the body's disc (radius r) may not reach it within the box horizon tau: walking
+    # straight at a crate face d ahead, at most (d - r) / tau toward it. Alone, the forbidden box's push
+    # in stage_steer got a single spider round a crate (the test above) with or without it; in a crowd,
+    # without it, neighbours pushed bodies to 5 cm from crates (12 spiders on crates, 600 frames).
+    from planner._crowd import AVOID_BOX_HORIZON, _avoid, _box_velocities, _boxes_now
+
+    model, state = _world(tmp_path, "orca-box", crate_centre=(0.9, 0.0), crate_width=0.5, start=(0.0, 0.0),
+                          goal=(3.0, 0.0))
+    boxes = _boxes_now(model, state.t)
+    assert state.pelvis[0, 2] == 0.0 and state.heading[0] == 0.0
+    d = 0.9 - 0.25 - state.pelvis[0, 0]  # to the crate's near face, straight ahead
+    r = model.avoid_radius
+    assert 0.0 < d - r < 0.3 * AVOID_BOX_HORIZON, "the crate must be near enough to bind a 0.3 m/s walk"
+    preferred = np.array([[0.3, 0.0]])
+    velocity, avoided = _avoid(model, state, preferred, np.array([3.0]), boxes,
+                               _box_velocities(model, state.t, boxes[0]), np.zeros(1, np.bool_))
+    assert avoided[0]
+    assert velocity[0, 0] <= (d - r) / AVOID_BOX_HORIZON + 1e-9
+    assert velocity[0, 0] == pytest.approx((d - r) / AVOID_BOX_HORIZON, abs=1e-6)  # no slower than it must
+    # Walking away from it: nothing to avoid.
+    velocity, avoided = _avoid(model, state, -preferred, np.array([3.0]), boxes,
+                               _box_velocities(model, state.t, boxes[0]), np.zeros(1, np.bool_))
+    assert not avoided[0] and velocity[0] == pytest.approx(-preferred[0])
+
+
 def test_feet_feedback_shifts_the_pelvis_by_the_gain_of_a_significant_offset(tmp_path):
     # Paper §5, Fig. 7: when the chosen footprints sit on average off the preferred ones by
     # more than the threshold, the pelvis moves toward them at feedback_gain per second.
