@@ -733,8 +733,8 @@ def _foot_room(model: CrowdModel) -> float:
 def _same_frame_conflicts(model: CrowdModel, cs, targets, valid) -> np.ndarray:
     """(F,) bool: valid plans whose target lies within a foot's room of an earlier valid plan's target
     (this frame's plans): of another character, or of the same one (two legs of a character planned
-    in one frame do not see each other's targets either: a spider's adjacent rear legs landed on one
-    spot and crossed, crates, seed 200)."""
+    in one frame do not see each other's targets either: on a variant of the runtime, a spider's
+    adjacent rear legs landed on one spot and crossed)."""
     conflict = np.zeros(cs.size, dtype=np.bool_)
     if np.count_nonzero(valid) < 2:
         return conflict
@@ -915,7 +915,8 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, fre
         excess = np.where(forced, np.hypot(state.feet[..., 0] - hips[..., 0], state.feet[..., 2] - hips[..., 2])
                           + threatened + 10.0 * cannot_follow, -np.inf)
         rank = np.argsort(np.argsort(-excess, axis=1, kind="stable"), axis=1, kind="stable")
-        room = model.n_legs // 2 - (~state.in_stance).sum(axis=1) - (kinds == 1).sum(axis=1)
+        spare = model.n_legs // 2 - (~state.in_stance).sum(axis=1)  # legs that may lift, gait and forced
+        room = spare - (kinds == 1).sum(axis=1)
         # A foot about to be hit by a moving box lifts even past that limit.
         kinds[forced & ((rank < room[:, None]) | threatened)] = 2
         # A foot the body waits for (its leg cannot follow it) that found no room goes before the
@@ -923,12 +924,11 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, fre
         # legs stepped in turn on the spot, two in the air at any time, while the body waited for
         # good (robot5 over a low crate, crates-moving seed 0: 192 frames with a foot inside it).
         # Only where that makes room (a frame with no leg to spare changes nothing by waiting).
-        spare = model.n_legs // 2 - (~state.in_stance).sum(axis=1)
         starved = (cannot_follow & forced & (kinds == 0)).any(axis=1) & (spare > 0)
         if starved.any():
             kinds[starved[:, None] & (kinds == 1) & ~far] = 0  # a foot that must step anyway steps
             room = spare - (kinds == 1).sum(axis=1)
-            kinds[forced & (rank < room[:, None])] = 2
+            kinds[forced & starved[:, None] & (rank < room[:, None])] = 2
     held = (cannot_follow & (kinds == 0)).any(axis=1)
     # Held from this frame on: take back this frame's move (the pelvis pose stays too).
     newly = held & ~state.body_held
