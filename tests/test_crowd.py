@@ -429,8 +429,8 @@ def test_a_crowds_feet_keep_a_foots_room_from_each_other():
 def test_two_feet_planned_in_one_frame_never_share_a_spot_whether_of_one_character_or_two():
     """Feet planned in the same frame do not see each other's targets: of two valid plans whose
     targets lie within a foot's room, the later one (in plan order) waits a frame. That holds for two
-    legs of one character as for two characters (a spider's adjacent rear legs landed on one spot
-    and their legs crossed, crates, seed 200)."""
+    legs of one character as for two characters (on a variant of the runtime, a spider's adjacent
+    rear legs landed on one spot and their legs crossed)."""
     import dataclasses
 
     from planner._crowd import _foot_room, _same_frame_conflicts
