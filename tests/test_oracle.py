@@ -853,9 +853,13 @@ def test_every_couple_scores_as_the_oracle_says(seed):
 # A fresh seed that failed (session 14; it fails on f93235d too, before the swing-reach rule): one couple
 # scores 0.496454823260 in the runtime and 0.496457128570 in the oracle (cell (8, 11), slice 1), 2.3e-6
 # apart. Not traced yet; kept here so that it stays checked and turns this test red once it is fixed.
-@pytest.mark.xfail(strict=True, reason="seed 251713580: a couple's score differs from the oracle's by 2.3e-6")
-def test_every_couple_scores_as_the_oracle_says_on_a_seed_that_failed():
-    test_every_couple_scores_as_the_oracle_says(251713580)
+# Another fresh seed of the same kind (session 17, CI on d20d94a; the session's changes did not touch the
+# scoring): a couple scores 0.501291243011 in the runtime and 0.501291617955 in the oracle (cell (2, 8),
+# slice 1 again), 3.7e-7 apart. Not traced yet either.
+@pytest.mark.xfail(strict=True, reason="a couple's score differs from the oracle's (2.3e-6, 3.7e-7), in slice 1")
+@pytest.mark.parametrize("seed", [251713580, 587286411])
+def test_every_couple_scores_as_the_oracle_says_on_a_seed_that_failed(seed):
+    test_every_couple_scores_as_the_oracle_says(seed)
 
 
 # ---------------------------------------------------------------------------- disagreements (fixed)
