@@ -262,6 +262,11 @@ def hips_world(model: CrowdModel, state: CrowdState) -> np.ndarray:
     return state.pelvis[:, None, :] + rotated
 
 
+def _landing_feet(state: CrowdState) -> np.ndarray:
+    """(C, L, 3) where each foot stands, or, swinging, lands."""
+    return np.where(state.in_stance[..., None], state.feet, state.swing_target)
+
+
 def _boxes_now(model: CrowdModel, t: float):
     obs = model.raster.obstacles
     if len(obs.yaws) == 0:
@@ -607,9 +612,6 @@ def stance_turn_bounds(model: CrowdModel, state: CrowdState) -> tuple[np.ndarray
     return lo, hi
 
 
-def _landing_feet(state: CrowdState) -> np.ndarray:
-    """(C, L, 3) where each foot stands, or, swinging, lands."""
-    return np.where(state.in_stance[..., None], state.feet, state.swing_target)
 
 
 def uncrossing_turn(model: CrowdModel, state: CrowdState, turn) -> np.ndarray:
@@ -765,7 +767,7 @@ def _with_neighbours_feet(model: CrowdModel, state: CrowdState, cs, own, preferr
         return np.ascontiguousarray(own.reshape(-1, 4)), np.arange(f + 1, dtype=np.int64) * k
     from scipy.spatial import cKDTree
 
-    support = np.where(state.in_stance[..., None], state.feet, state.swing_target)[..., [0, 2]].reshape(-1, 2)
+    support = _landing_feet(state)[..., [0, 2]].reshape(-1, 2)
     owner = np.repeat(np.arange(n_chars), n_legs)
     radius = model.config.search_radius_m + 2.0 * _foot_room(model)
     found = cKDTree(support).query_ball_point(preferred, radius, return_sorted=True)
@@ -1051,7 +1053,7 @@ def _stamp_others(model: CrowdModel, state: CrowdState, chars: np.ndarray, forb,
     box = model.creature.body_box
     # A swinging foot is stamped where it will land: two characters' feet planned a frame apart went
     # for the same spot, the later one not seeing the earlier one's target.
-    support = np.where(state.in_stance[..., None], state.feet, state.swing_target)
+    support = _landing_feet(state)
     stamp_other_characters(forb, origin, config.cell_size, start, index, xz,
                            np.ascontiguousarray(state.heading), 0.5 * float(box[0]), 0.5 * float(box[1]),
                            np.ascontiguousarray(support[..., [0, 2]]), np.ones(state.in_stance.shape, np.bool_),
@@ -1133,7 +1135,7 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     # The other legs at touchdown time: their hips carried forward with the pelvis, their feet
     # where they stand (or will land). Mixing predicted and current hips would make legs
     # 'cross' at the hips.
-    support = np.where(state.in_stance[..., None], state.feet, state.swing_target)
+    support = _landing_feet(state)
     oj = model.other_legs[ls]  # (F, L-1)
     # A swinging neighbour is blocked both where its foot is now and where it will land, so two
     # legs swinging side by side do not cut across each other.
@@ -1311,7 +1313,7 @@ def _merge_results(parts, n: int):
 
 def stage_pelvis(model: CrowdModel, state: CrowdState) -> None:
     r = model.raster
-    support = np.ascontiguousarray(np.where(state.in_stance[..., None], state.feet, state.swing_target))
+    support = np.ascontiguousarray(_landing_feet(state))
     bob = model.controller.bob_factor * model.creature.standing_height * np.sin(4.0 * np.pi * state.gaits.needle)
     state.pelvis_rise[:] = -state.pelvis[:, 1]
     y = np.empty(state.pelvis.shape[0])
