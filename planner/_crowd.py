@@ -1184,7 +1184,8 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     state.tucked[vc, vl] = False
     tuck = ~out.valid & ((new & state.threatened[cs, ls]) | state.tucked[cs, ls])
     if tuck.any():
-        left = np.where(new, t_swing, state.swing_T[cs, ls] - state.swing_t[cs, ls])
+        # A new tuck is a flinch (TUCK_FRAMES); a tucked foot whose re-plan fails goes on as it was.
+        left = np.where(new, TUCK_FRAMES * model.dt, state.swing_T[cs, ls] - state.swing_t[cs, ls])
         tuck_swings(model, state, cs[tuck], ls[tuck], hips, left[tuck])
     fresh = ok & new
     if fresh.any():
@@ -1202,6 +1203,10 @@ TUCK_REACH = 0.25
 """x the rest foot's offset from its hip: how far out a tucked foot is held (tuck_swings)."""
 TUCK_LIFT = 0.5
 """x the hip's height: how high a tucked foot is held above the ground under its hip."""
+TUCK_FRAMES = 3
+"""Frames a foot takes to tuck: a flinch, the fewest that never land it (tuck_swings). At the pace
+of a swing (0.3 s) a crate closing at 0.3 m/s caught a spider's foot on its way in (crates-moving,
+12 spiders, 1200 frames, seed 3: 3 collisions, 0 with the flinch)."""
 
 
 def tuck_points(model: CrowdModel, state: CrowdState, cs, ls, hips) -> np.ndarray:
@@ -1218,7 +1223,7 @@ def tuck_points(model: CrowdModel, state: CrowdState, cs, ls, hips) -> np.ndarra
 
 def tuck_swings(model: CrowdModel, state: CrowdState, cs, ls, hips, duration) -> None:
     """Swing feet ``ls`` of characters ``cs`` toward their tuck points (:func:`tuck_points`) over
-    ``duration`` s (at least three frames, so a tucked foot never lands): up first, then in.
+    ``duration`` s (at least TUCK_FRAMES frames, so a tucked foot never lands): up first, then in.
 
     The defined fallback for a stance foot a moving box will cover and that has no footprint: the
     body is no longer held by it (other legs may still hold it), and the foot looks for a
@@ -1233,7 +1238,7 @@ def tuck_swings(model: CrowdModel, state: CrowdState, cs, ls, hips, duration) ->
     state.trajectories[cs, ls] = path
     state.swing_target[cs, ls] = target
     state.swing_t[cs, ls] = 0.0
-    state.swing_T[cs, ls] = np.maximum(duration, 3.0 * model.dt)
+    state.swing_T[cs, ls] = np.maximum(duration, TUCK_FRAMES * model.dt)
     state.in_stance[cs, ls] = False
     state.wants_swing[cs, ls] = False
     state.tucked[cs, ls] = True

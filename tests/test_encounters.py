@@ -295,20 +295,24 @@ def test_a_foot_a_wide_crate_leaves_no_footprint_is_tucked_out_of_its_way(tmp_pa
     def run():
         model, state = _world(tmp_path, "tuck", crate_centre=(-1.8, 0.45), crate_width=0.6, start=(0.0, 0.0),
                               goal=(0.0, 0.0), velocity=(0.2, 0.0))
-        inside, tucked = [], []
+        inside, tucked, flinch = [], [], []
 
         def check(s):
             c, h, y = _crate_now(model, s.t)
             feet = np.where(s.ik_on[0], s.fk_feet[0], s.feet[0])
             inside.append(int(_inside(feet[:, [0, 2]], c, h, y).sum()))
+            new = s.tucked[0] & ~(tucked[-1] if tucked else np.zeros_like(s.tucked[0]))
+            flinch.extend(s.swing_T[0, new] / model.dt)
             tucked.append(s.tucked[0].copy())
 
         counters = _run(model, state, 540, check)
         assert _crate_now(model, state.t)[0][0] - 0.3 > 0.5, "the crate must pass the spider"
-        return sum(inside), np.array(tucked), counters, state
+        return sum(inside), np.array(tucked), counters, state, flinch
 
-    inside, tucked, counters, state = run()
+    inside, tucked, counters, state, flinch = run()
     assert tucked[:, state.feet[0, :, 2] > 0.2].any(), "a left foot must have been tucked"
+    # A foot tucks in TUCK_FRAMES frames (a flinch), not at a swing's pace.
+    assert flinch and np.allclose(flinch, crowd.TUCK_FRAMES), flinch
     assert not tucked[:, state.feet[0, :, 2] < -0.2].any(), "no right foot is in the crate's way"
     assert inside == 0
     assert state.in_stance[0].all() and not state.tucked[0].any(), "every foot lands again"
