@@ -74,10 +74,11 @@ def stride_length_k(params, v, h):
 
 @nb.njit(cache=True)
 def stride_frequency_k(params, v, h):
-    """Kernel twin of :func:`planner._timing.stride_frequency` (Hz); 0 at v = 0."""
-    if v <= 0.0:
+    """Kernel twin of :func:`planner._timing.stride_frequency` (Hz); 0 where the stride is 0."""
+    length = stride_length_k(params, v, h)
+    if length <= 0.0:
         return 0.0
-    return max(v / stride_length_k(params, v, h), params[T_MIN_FREQUENCY])
+    return max(v / length, params[T_MIN_FREQUENCY])
 
 
 @nb.njit(cache=True)

@@ -134,7 +134,9 @@ def stride_length(timing: GaitTiming, v, h):
 
 
 def stride_frequency(timing: GaitTiming, v, h):
-    """f = max(v / lambda, min_frequency_hz) for v > 0, 0 at v = 0 (Hz). Broadcasts ``v`` and ``h``."""
+    """f = max(v / lambda, min_frequency_hz) where lambda > 0, else 0 (Hz): 0 at v = 0, and at the
+    speeds so small that Fr^stride_exponent underflows to 0 (a body braking geometrically reached
+    2e-177 m/s; v / 0 stopped the run). Broadcasts ``v`` and ``h``."""
     speed, height, scalar = _speed_height(v, h)
     return _out(_stride_frequency(timing, speed, height), scalar)
 
@@ -151,7 +153,7 @@ def _stride_length(timing: GaitTiming, speed: np.ndarray, height) -> np.ndarray:
 def _stride_frequency(timing: GaitTiming, speed: np.ndarray, height) -> np.ndarray:
     """:func:`stride_frequency` of speeds already checked."""
     length = _stride_length(timing, speed, height)
-    moving = speed > 0.0
+    moving = length > 0.0
     with np.errstate(divide="ignore", invalid="ignore"):
         natural = np.where(moving, speed / np.where(moving, length, 1.0), 0.0)
     return np.where(moving, np.maximum(natural, timing.min_frequency_hz), 0.0)

@@ -352,6 +352,9 @@ def test_stride_length_is_dynamic_similarity():
     assert np.all(fast) and np.all(np.diff(f, axis=0) >= 0)
     assert stride_frequency(timing, 0.0, 0.12) == 0.0
     assert stride_frequency(timing, 1e-9, 0.12) == timing.min_frequency_hz
+    # So slow that Fr^0.3 underflows: no stride, so no tempo (v / 0 stopped a run: robot5 on mixed,
+    # 8 characters, LOD zoomed, seed 900, braked geometrically to 2e-177 m/s by frame 491).
+    assert stride_length(timing, 1e-200, 0.12) == 0.0 and stride_frequency(timing, 1e-200, 0.12) == 0.0
     with pytest.raises(ValueError, match="speed"):
         stride_length(timing, -1.0, 0.12)
     with pytest.raises(ValueError, match="height"):
@@ -380,7 +383,7 @@ def test_kernel_twins_match_numpy():
     rng = np.random.default_rng(2)
     for timing in (GaitTiming(), GaitTiming(stride_exponent=0.0, min_frequency_hz=0.1, duty_slope=0.0)):
         params = timing.to_array()
-        for v, h in zip(np.r_[0.0, rng.uniform(0, 3, 50)], np.r_[0.12, rng.uniform(0.03, 0.6, 50)]):
+        for v, h in zip(np.r_[0.0, 1e-200, rng.uniform(0, 3, 50)], np.r_[0.12, 0.12, rng.uniform(0.03, 0.6, 50)]):
             assert stride_length_k(params, v, h) == pytest.approx(stride_length(timing, v, h), rel=1e-14, abs=0)
             assert stride_frequency_k(params, v, h) == pytest.approx(stride_frequency(timing, v, h), rel=1e-14)
             assert duty_factor_k(params, v, h) == pytest.approx(duty_factor(timing, v, h), rel=1e-14)

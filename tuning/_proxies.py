@@ -172,8 +172,8 @@ def stride_length(timing, speed, leg_height):
 
 
 def stride_frequency(timing, speed, leg_height):
-    """f(v) = max(v / lambda(v), min_frequency_hz) for v > 0, 0 at v = 0 (planner._timing)."""
-    moving = speed > 0.0
+    """f(v) = max(v / lambda(v), min_frequency_hz) where lambda > 0, else 0 (planner._timing)."""
+    moving = stride_length(timing, speed, leg_height) > 0.0
     v = jnp.where(moving, speed, 1.0)
     natural = v / stride_length(timing, v, leg_height)
     return jnp.where(moving, jnp.maximum(natural, timing[T_MIN_FREQUENCY]), 0.0)
