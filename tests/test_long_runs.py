@@ -60,8 +60,8 @@ KNOWN: dict[tuple[str, str], dict[str, str]] = {
 }
 
 # (scenario, creature, lod) -> every seed that failed a safety promise there (known or not). A cell
-# with no known defect runs them all; a cell with one runs the first beside its fresh seed (the rest
-# only repeat what KNOWN tolerates; they run again once its entry goes).
+# with no known defect runs them all; a cell with one runs only its fresh seed (its fixed seeds would
+# repeat what KNOWN tolerates, at a second a run; they run again once its entry goes).
 FIXED_SEEDS: dict[tuple[str, str, str], tuple[int, ...]] = {
     ("crates", "quadruped", "off"): (1005,),
     ("crates", "robot5", "off"): (900, 901, 1001),
@@ -103,7 +103,7 @@ def test_a_long_crowded_run_keeps_every_safety_promise(scenario, creature, lod):
     salt = sum(map(ord, f"{scenario}/{creature}/{lod}"))
     failures, tolerated = [], []
     fixed = FIXED_SEEDS.get((scenario, creature, lod), ())
-    for seed in fresh_seeds(fixed[:1] if known else fixed, 1, salt=salt):
+    for seed in fresh_seeds(() if known else fixed, 1, salt=salt):
         run = run_one({"scenario": scenario, "creature": creature, "seed": seed, "characters": CHARACTERS,
                        "frames": FRAMES, "lod": lod})
         broken = {name: run["violations"][name] for name in SAFETY if run["violations"][name]}
