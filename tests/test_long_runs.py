@@ -38,7 +38,8 @@ SAFETY = ("collisions", "forbidden_footprints", "leg_crossings", "body_overlaps"
 _HELD = ("a crate runs down a character whose body is held by a foot it cannot follow: tucked feet end in the crate"
          " (traced on crates-moving, spider)")
 _FEET_IN = "rendered feet inside crates (untraced)"
-_TOP = "robot5 feet planned on a box top its leg cannot reach (the planner checks reach in xz only)"
+_TOP = ("robot5: tucked feet inside a forbidden crate that runs alongside, the body already over its edge (seed"
+        " 1003, 120 foot-frames), and feet planned on a box top the leg cannot reach (reach checked in xz only)")
 _CROSS = "adjacent legs cross while the body turns or is held and the gait swings a neighbour (untraced per seed)"
 _SLIP = ("a foot lands in the frame its body is held and its pose taken back: out of reach, it snaps on 2 frames later"
          " (traced on crates-moving, spider)")
