@@ -612,8 +612,6 @@ def stance_turn_bounds(model: CrowdModel, state: CrowdState) -> tuple[np.ndarray
     return lo, hi
 
 
-
-
 def uncrossing_turn(model: CrowdModel, state: CrowdState, turn) -> np.ndarray:
     """(C,) rad: ``turn``, halved, then none, for a body it would turn across its legs: two legs
     whose ground lines (hip to foot; a swinging foot where it lands) would cross and do not now.
@@ -752,10 +750,11 @@ def _same_frame_conflicts(model: CrowdModel, cs, targets, valid) -> np.ndarray:
     return conflict
 
 
-def _with_neighbours_feet(model: CrowdModel, state: CrowdState, cs, own, preferred):
+def _with_neighbours_feet(model: CrowdModel, state: CrowdState, cs, own, preferred, support):
     """(legs (M, 4), legs_start (F + 1,)): each planned foot's other legs (``own``, hip -> foot
     segments of its character) followed by the feet of other characters near its preferred footprint,
-    as zero-length legs (x, z, x, z): where they stand, or, swinging, where they will land.
+    as zero-length legs (x, z, x, z): where they stand, or, swinging, where they will land
+    (``support``, :func:`_landing_feet` of this state).
 
     The search keeps a foot's room (``block_radius``) from every foot in the list, so a foot never lands
     on another character's foot (``shared_foot_spots``); a neighbour's foot also lowers the leg-spacing
@@ -767,7 +766,7 @@ def _with_neighbours_feet(model: CrowdModel, state: CrowdState, cs, own, preferr
         return np.ascontiguousarray(own.reshape(-1, 4)), np.arange(f + 1, dtype=np.int64) * k
     from scipy.spatial import cKDTree
 
-    support = _landing_feet(state)[..., [0, 2]].reshape(-1, 2)
+    support = support[..., [0, 2]].reshape(-1, 2)
     owner = np.repeat(np.arange(n_chars), n_legs)
     radius = model.config.search_radius_m + 2.0 * _foot_room(model)
     found = cKDTree(support).query_ball_point(preferred, radius, return_sorted=True)
@@ -1145,7 +1144,7 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     later = np.stack([hx, hz, support[cs[:, None], oj, 0], support[cs[:, None], oj, 2]], axis=-1)
     now = np.stack([hx, hz, state.feet[cs[:, None], oj, 0], state.feet[cs[:, None], oj, 2]], axis=-1)
     own = np.concatenate([later, now], axis=1)  # (F, 2 (L - 1), 4)
-    legs, legs_start = _with_neighbours_feet(model, state, cs, own, preferred)
+    legs, legs_start = _with_neighbours_feet(model, state, cs, own, preferred, support)
     couples, slices, _ = budgets
     request = FootBatch(
         elevation=None, ground=None, forbidden=None, origins=None, foot_char=None,
