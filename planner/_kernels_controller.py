@@ -272,16 +272,21 @@ def count_close_pairs(points, owner, radius):
     return count
 
 
+@nb.njit(cache=True, inline="always")
+def _hip_xz(pelvis, hips_body, c, i, co, si):
+    """(x, z) of leg i's hip of character c, the body's heading given by its cosine and sine."""
+    return (pelvis[c, 0] + hips_body[i, 0] * co - hips_body[i, 2] * si,
+            pelvis[c, 2] + hips_body[i, 0] * si + hips_body[i, 2] * co)
+
+
 @nb.njit(cache=True)
 def _lines_cross_turned(pelvis, heading, hips_body, feet, c, i, j):
     """Legs i and j of character c, the body at ``heading``: their ground lines (hip to foot, the
     hips swung with the body about the pelvis) cross properly."""
     co = math.cos(heading)
     si = math.sin(heading)
-    ix = pelvis[c, 0] + hips_body[i, 0] * co - hips_body[i, 2] * si
-    iz = pelvis[c, 2] + hips_body[i, 0] * si + hips_body[i, 2] * co
-    jx = pelvis[c, 0] + hips_body[j, 0] * co - hips_body[j, 2] * si
-    jz = pelvis[c, 2] + hips_body[j, 0] * si + hips_body[j, 2] * co
+    ix, iz = _hip_xz(pelvis, hips_body, c, i, co, si)
+    jx, jz = _hip_xz(pelvis, hips_body, c, j, co, si)
     return segments_cross(ix, iz, feet[c, i, 0], feet[c, i, 2], jx, jz, feet[c, j, 0], feet[c, j, 2])
 
 
