@@ -18,6 +18,9 @@ documented definitions (the field docs of ``planner/_weights.py``, the docstring
   cell centres) and the potential field;
 * the wavefront as scipy's Dijkstra, with *every* shortest path enumerated (ties between equal
   paths are explicit: a couple whose paths differ keeps the set of their scores);
+* a path sample within ``BORDER_TOL`` of a cell border lies in the cells on both sides (the runtime
+  and the oracle compute the samples in different orders of operations, ulps apart): the ground
+  under it, so the 3D profile and its jerk, may be either side's, and both are accepted;
 * line-of-sight refinement of the naive cells, the Hermite path (Catmull-Rom tangents, then
   halved, then zero), its length, curvature energy and clearance, the climb;
 * the 3D height profile (scipy's PCHIP through the elevated waypoints), its length, its climb and
@@ -32,6 +35,9 @@ part (a)): a footprint on the border of its cell was refused when the neighbour 
 ``(x - origin) / cell`` rounded into it; a size-increase cell under another leg became an other-leg
 cell, which hid it from the obstacle-proximity term and let a foot land on it, on the box. The oracle
 keeps the old conventions as options (``endpoint="floor"``, ``leg_over_size_increase=True``).
+
+A third, on two fresh seeds (jerk 0.4 % apart on a path lifted over a box), was neither side's error: a
+sample lay on a row border and the two rounded it into different rows (see ``FIXED_SEEDS``).
 
 (b) each score term on a 5 x 5 grid against numbers worked out by hand (``test_hand_*``): the runtime's
 own functions for the term (``harvest_foot``; the goodness and jerk kernels) against literal numbers.
@@ -57,6 +63,8 @@ SCORE_TOL = 1e-9  # a score or goodness, dimensionless
 METRIC_TOL = 1e-9  # a raw metric (m, rad, or the scale-free energies, relative)
 PATH_TIE_TOL = 1e-12  # m: two wavefront costs this close are the same cost (a tie between paths)
 POINT_TOL = 1e-12  # m: a footprint moved out of another foot's room, computed in another order of operations
+BORDER_TOL = 1e-12  # m: a path sample this close to a cell border lies in the cells on both sides (a tie)
+MAX_BORDER_VARIANTS = 64  # assignments of border samples to cells tried per path
 SQRT2 = math.sqrt(2.0)
 
 # Documented constants of the path construction (planner/_kernels_foot.py's module constants and
@@ -518,14 +526,40 @@ class Oracle:
                 return dense, cells
         return None, None
 
+    def _border_assignments(self, dense, cells):
+        """Every assignment of the samples to cells, the documented one first: a sample within BORDER_TOL of
+        a cell border lies in the cells on both sides (the last sample stays in the footprint's cell)."""
+        choices = []
+        for i, ((x, z), own) in enumerate(zip(dense, cells)):
+            near = {own}
+            if i < len(dense) - 1:
+                for dx, dz in itertools.product((-BORDER_TOL, 0.0, BORDER_TOL), repeat=2):
+                    r, c = cell_of(x + dx, z + dz, self.ox, self.oz, self.cell)
+                    if 0 <= r < self.n_rows and 0 <= c < self.n_cols:
+                        near.add((r, c))
+            choices.append([own] + sorted(near - {own}))
+        ambiguous = [i for i, ch in enumerate(choices) if len(ch) > 1]
+        yield list(cells)
+        for picks in itertools.islice(itertools.product(*(choices[i] for i in ambiguous)), 1, MAX_BORDER_VARIANTS):
+            alt = list(cells)
+            for i, rc in zip(ambiguous, picks):
+                alt[i] = rc
+            yield alt
+
     def _couple(self, cand, sl, kept):
-        """Raw metrics and terms of the couple (cand, slice) along the path through ``kept``."""
-        cell, cfg, q, w = self.cell, self.cfg, self.q, self.w
+        """The couple (cand, slice) along the path through ``kept``: one variant per assignment of its
+        samples to cells (:meth:`_border_assignments`), [None] when no 2D path fits."""
         passable = sl["passable"].copy()
         passable[cand["cell"]] = True  # the path may end in its target (a goal-only cell too)
         dense, cells = self._path_2d(kept, passable, cand["cell"])
         if dense is None or len(dense) < 2:
-            return None
+            return [None]
+        return [self._couple_along(cand, sl, kept, passable, dense, alt)
+                for alt in self._border_assignments(dense, cells)]
+
+    def _couple_along(self, cand, sl, kept, passable, dense, cells):
+        """Raw metrics and terms of the couple (cand, slice) along the 2D path ``dense``, its samples in ``cells``."""
+        cell, cfg, q, w = self.cell, self.cfg, self.q, self.w
         n = len(dense)
         chords = np.linalg.norm(np.diff(dense, axis=0), axis=1)
         cum = np.concatenate([[0.0], np.cumsum(chords)])
@@ -597,7 +631,8 @@ class Oracle:
     def couples(self):
         """[(candidate, slice index, variants)] for every (candidate, slice) whose target the slice's
         wavefront reaches. Ties are explicit: the variants are the couples of the distinct refined paths of
-        all the tied shortest naive paths, None for one that yields no valid 2D path."""
+        all the tied shortest naive paths (and of each path's samples on a cell border, in the cells on either
+        side), None for one that yields no valid 2D path."""
         out = []
         eps = self.cfg.slice_epsilon_m
         for s, level in enumerate(self.levels):
@@ -608,7 +643,7 @@ class Oracle:
                 passable = sl["passable"].copy()
                 passable[cand["cell"]] = True
                 kepts = {self._kept(p, cand["point"], passable) for p in self._shortest_paths(sl, cand["cell"])}
-                out.append((cand, s, [self._couple(cand, sl, k) for k in sorted(kepts)]))
+                out.append((cand, s, [v for k in sorted(kepts) for v in self._couple(cand, sl, k)]))
         return out
 
 
@@ -634,7 +669,10 @@ def geometric_jerk(poly):
 
 N = 14  # cells per side: with the default radius (4 cells) and margin (6 cells) the search's region of
 CELL = 0.07  # interest is the whole map when the preferred footprint's cell is in rows/cols 3..10.
-FIXED_SEEDS = tuple(range(40)) + (1580367954,)  # every seed that ever failed joins (1580367954: a pushed point 1 ulp apart)
+# Every seed that ever failed joins: 1580367954, a pushed point 1 ulp apart; 251713580 and 587286411, a path
+# sample on a cell border (z 3.7e-16 m past it), in one cell for the runtime and in the next for the oracle,
+# so the ground under it and the jerk differed (0.4 %): ties now, BORDER_TOL.
+FIXED_SEEDS = tuple(range(40)) + (1580367954, 251713580, 587286411)
 N_FRESH = 10
 
 
@@ -848,18 +886,6 @@ def test_every_couple_scores_as_the_oracle_says(seed):
             score = h.couple_scores[k, s, 0]
             assert any(v is not None and abs(v["score"] - score) <= SCORE_TOL for v in couple[2]), \
                 f"{where}: the runtime scores {score:.12f}, the oracle {_describe(couple)}"
-
-
-# A fresh seed that failed (session 14; it fails on f93235d too, before the swing-reach rule): one couple
-# scores 0.496454823260 in the runtime and 0.496457128570 in the oracle (cell (8, 11), slice 1), 2.3e-6
-# apart. Not traced yet; kept here so that it stays checked and turns this test red once it is fixed.
-# Another fresh seed of the same kind (session 17, CI on d20d94a; the session's changes did not touch the
-# scoring): a couple scores 0.501291243011 in the runtime and 0.501291617955 in the oracle (cell (2, 8),
-# slice 1 again), 3.7e-7 apart. Not traced yet either.
-@pytest.mark.xfail(strict=True, reason="a couple's score differs from the oracle's (2.3e-6, 3.7e-7), in slice 1")
-@pytest.mark.parametrize("seed", [251713580, 587286411])
-def test_every_couple_scores_as_the_oracle_says_on_a_seed_that_failed(seed):
-    test_every_couple_scores_as_the_oracle_says(seed)
 
 
 # ---------------------------------------------------------------------------- disagreements (fixed)
