@@ -17,6 +17,15 @@ more than one height can give, the stance legs' folding wins (a landing point lo
 pelvis below what the feet on the ground can fold to). The body never sinks into the
 ground for it: the pelvis stays ``body_thickness`` above the highest ground under the
 body box.
+
+Smoothing (optional, ``ControllerConfig.pelvis_lag``; off by default, see there for what it
+costs): the hull moves in steps (a foot lifting off takes its stance point out, a landing point
+changes when a swing re-plans), and a body set on it each frame jumps with it (up to 0.6 rad of
+pitch and half a standing height in one frame, an ant on ``stairs``). With a lag, the body's
+pitch, roll and base height (the pelvis's before the bob) go ``smoothing`` = 1 - exp(-dt / tau)
+of the way from the last frame's values to this frame's per frame; the stance feet's height
+ranges and the ground under the body stay hard limits, and a swinging foot's landing point is
+approached through the lag. ``smoothing`` 1 is the paper's pose, exactly.
 """
 
 from __future__ import annotations
@@ -69,8 +78,9 @@ def _sample(top, origin_x, origin_z, cell, x, z):
 
 @nb.njit(cache=True, parallel=True)
 def pelvis_from_hulls(top, origin_x, origin_z, cell, pelvis, heading, support, in_stance, body_length, body_width,
-                      standing_height, heights, body_thickness, bob, out_y, out_pitch, out_roll, out_hull):
-    """Write pelvis height, pitch, roll and the forward hull height at the centre.
+                      standing_height, heights, body_thickness, bob, smoothing, last_base, last_pitch, last_roll, out_y,
+                      out_pitch, out_roll, out_base):
+    """Write pelvis height, pitch, roll and the base height (the pelvis's before the bob).
 
     ``support`` (C, L, 3): the feet used for the hull; ``in_stance`` (C, L): the feet on the ground
     (a swinging foot's landing point lowers no pelvis: the stance legs would have to fold for it);
@@ -78,7 +88,9 @@ def pelvis_from_hulls(top, origin_x, origin_z, cell, pelvis, heading, support, i
     ``heights`` (L, 2) m: the least and most the pelvis stands above each leg's foot along its up
     axis (:func:`planner._workspace.height_ranges`; the least for stance feet only, the most for
     every support point);
-    ``body_thickness`` (m): the least it stands above the ground under its body box.
+    ``body_thickness`` (m): the least it stands above the ground under its body box;
+    ``smoothing`` in (0, 1]: the fraction of the way from ``last_base``, ``last_pitch``, ``last_roll``
+    (C,) to this frame's that the body goes (module doc).
     """
     n_chars = pelvis.shape[0]
     n_legs = support.shape[1]
@@ -115,7 +127,9 @@ def pelvis_from_hulls(top, origin_x, origin_z, cell, pelvis, heading, support, i
         h = min(h, hl)
         pitch = math.atan(slope)
         roll = math.atan(slope_l)
-        y_body = h + standing_height + bob[c]
+        if smoothing < 1.0:
+            pitch = last_pitch[c] + smoothing * (pitch - last_pitch[c])
+            roll = last_roll[c] + smoothing * (roll - last_roll[c])
         # A foot at body offset (f, u, l) lies sp f + cp cr u + cp sr l above the pelvis
         # (planner._ik.body_rotation), so -u stays within [least, most] while the pelvis is within
         # foot_y - sp f - cp sr l + cp cr [least, most] (f, l: its ground offsets along the heading).
@@ -123,15 +137,26 @@ def pelvis_from_hulls(top, origin_x, origin_z, cell, pelvis, heading, support, i
         cpcr = math.cos(pitch) * math.cos(roll)
         cpsr = math.cos(pitch) * math.sin(roll)
         low = -np.inf
+        high = np.inf
+        reach = np.inf
         for i in range(n_legs):
             foot = y[3 + i] - sp * s[3 + i] - cpsr * t[3 + i]
-            y_body = min(y_body, foot + cpcr * heights[i, 1])
+            reach = min(reach, foot + cpcr * heights[i, 1])
             if in_stance[c, i]:
                 low = max(low, foot + cpcr * heights[i, 0])
+                high = min(high, foot + cpcr * heights[i, 1])
+        base = max(min(h + standing_height, reach), low)
+        if smoothing < 1.0:
+            # The lag is the body's; the stance feet's reach and the ground under the body are hard
+            # limits (a swinging foot's landing point asks, through the lag, before it lands).
+            base = last_base[c] + smoothing * (base - last_base[c])
+            y_body = min(base + bob[c], high)
+        else:
+            y_body = min(h + standing_height + bob[c], reach)
         y_body = max(y_body, low)
         ground = max(max(y[0], y[1]), max(y[2], max(yl[0], yl[2])))
         y_body = max(y_body, ground + body_thickness)
-        out_hull[c] = h
+        out_base[c] = base
         out_y[c] = y_body
         out_pitch[c] = pitch
         out_roll[c] = roll

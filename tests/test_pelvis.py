@@ -1,0 +1,70 @@
+"""The pelvis on its support hulls (paper §3.2, Fig. 4b) and the optional lag that follows them
+(``ControllerConfig.pelvis_lag``), on a scene small enough to work out by hand.
+
+The scene: flat ground at 0, a body 0.2 m long and 0.2 m wide at the origin heading +x (its
+left is +z), standing height 0.3 m, body thickness 0.01 m. Four stance feet at x = +-0.5: the
+two on the left (z = +0.5) stand on a step 0.2 m high, the two on the right (z = -0.5) on the
+ground. The sagittal hull is the step, 0.2 m; the lateral hull is the line from (-0.5, 0) to
+(0.5, 0.2): 0.1 m under the centre, slope 0.2. The body stands on the lower of the two: its
+base is 0.1 + 0.3 = 0.4 m, pitch 0, roll atan(0.2).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from planner import ControllerConfig
+from planner._kernels_body import pelvis_from_hulls
+
+TOL = 1e-12  # m, rad
+STANDING, THICKNESS = 0.3, 0.01
+FEET = np.array([[[0.5, 0.2, 0.5], [-0.5, 0.2, 0.5], [0.5, 0.0, -0.5], [-0.5, 0.0, -0.5]]])
+
+
+def _pose(smoothing, last, most=10.0):
+    """(y, pitch, roll, base) of the scene's body, from the last frame's (base, pitch, roll)."""
+    top = np.zeros((5, 5))
+    heights = np.tile([0.0, most], (4, 1))
+    out = [np.empty(1) for _ in range(4)]
+    pelvis_from_hulls(top, -2.5, -2.5, 1.0, np.array([[0.0, 0.4, 0.0]]), np.zeros(1), FEET,
+                      np.ones((1, 4), np.bool_), 0.2, 0.2, STANDING, heights, THICKNESS, np.zeros(1), smoothing,
+                      np.array([last[0]]), np.array([last[1]]), np.array([last[2]]), *out)
+    return tuple(float(o[0]) for o in out)
+
+
+def test_without_a_lag_the_body_stands_on_the_lower_hull():
+    y, pitch, roll, base = _pose(1.0, (123.0, 1.0, -1.0))  # the last frame's pose plays no part
+    assert (y, pitch, roll, base) == pytest.approx((0.4, 0.0, math.atan(0.2), 0.4), abs=TOL)
+
+
+def test_a_lag_goes_its_fraction_of_the_way_from_the_last_pose():
+    y, pitch, roll, base = _pose(0.25, (0.3, 0.08, 0.0))
+    assert roll == pytest.approx(0.25 * math.atan(0.2), abs=TOL)
+    assert pitch == pytest.approx(0.08 + 0.25 * (0.0 - 0.08), abs=TOL)
+    assert base == pytest.approx(0.3 + 0.25 * (0.4 - 0.3), abs=TOL)
+    assert y == pytest.approx(base, abs=TOL)  # no bob, and no limit binds
+
+
+def test_a_stance_foots_reach_is_a_hard_limit_on_the_lagged_body():
+    """Legs that reach 0.35 m above their feet (along the body's up axis): the right feet, on the
+    ground, hold the pelvis at or under 0.5 sin(roll) cos(pitch) + 0.35 cos(pitch) cos(roll)
+    (planner._kernels_body). A body coming down from 0.5 m would go a quarter of the way, to
+    about 0.47 m; the reach holds it at 0.374 m."""
+    y, pitch, roll, base = _pose(0.25, (0.5, 0.0, 0.0), most=0.35)
+    r = 0.25 * math.atan(0.2)
+    high = 0.5 * math.sin(r) + 0.35 * math.cos(r)
+    assert pitch == pytest.approx(0.0, abs=TOL) and roll == pytest.approx(r, abs=TOL)
+    assert base == pytest.approx(0.5 + 0.25 * (high - 0.5), abs=TOL)
+    assert y == pytest.approx(high, abs=TOL)
+    assert y < base - 0.09
+
+
+def test_the_lag_is_checked():
+    assert ControllerConfig().pelvis_lag == 0.0  # off by default: the paper's pose (see the field's note)
+    with pytest.raises(ValueError, match="pelvis_lag"):
+        ControllerConfig(pelvis_lag=-0.1)
+    with pytest.raises(ValueError, match="pelvis_lag"):
+        ControllerConfig(pelvis_lag=math.nan)
