@@ -94,8 +94,15 @@ class Recorder:
             "swing_phase": np.zeros((frames, c, l), np.float32),
             "joint_angles": np.zeros((frames, c, l, s), np.float32),
             "ik_on": np.zeros((frames, c), np.bool_),
+            # What the metering of a run reads besides the pose, so that its figures can be recomputed
+            # from the file: the yaw each foot was planned with (the foot's rectangle), the body's
+            # commanded speed (the stride meter's 'steady'), and with a LOD mode each character's level.
+            "foot_yaw": np.zeros((frames, c, l), np.float32),
+            "speed": np.zeros((frames, c), np.float32),
             "stage_seconds": np.zeros((frames, len(STAGES)), np.float64),
         }
+        if state.lod_level is not None:
+            self.arrays["lod_level"] = np.zeros((frames, c), np.int8)
         self.events: list[np.ndarray] = []
 
     def capture(self, k: int, state: CrowdState, timings: dict) -> None:
@@ -107,6 +114,10 @@ class Recorder:
         a["swing_phase"][k] = np.where(state.in_stance, 0.0, state.swing_t / np.maximum(state.swing_T, 1e-9))
         a["joint_angles"][k] = state.angles
         a["ik_on"][k] = state.ik_on
+        a["foot_yaw"][k] = state.foot_yaws
+        a["speed"][k] = state.speed
+        if "lod_level" in a:
+            a["lod_level"][k] = state.lod_level
         a["stage_seconds"][k] = [timings[s] for s in STAGES]
         if state.last_plans is not None:
             cs, ls, kinds, out = state.last_plans

@@ -37,6 +37,10 @@ class Recording:
     joint_angles:  (F, C, L, S + 1) [azimuth, pitch_0, ..., pitch_{S-1}], rad (:mod:`planner._ik`).
     ik_on:         (F, C) bool: the IK solved this character's legs this frame (LOD off-screen: no).
     events:        (E, len(header["event_columns"])) planning events.
+    foot_yaw:      (F, C, L) yaw of each foot's rectangle, rad, or None (recorded before it was kept).
+    speed:         (F, C) commanded body speed, m/s, or None (likewise).
+    lod_level:     (F, C) level of detail of each character (:data:`planner._lod.LEVEL_NAMES`), or
+                   None (LOD off, or recorded before it was kept).
     """
 
     path: Path
@@ -49,6 +53,9 @@ class Recording:
     joint_angles: np.ndarray
     ik_on: np.ndarray
     events: np.ndarray
+    foot_yaw: np.ndarray | None = None
+    speed: np.ndarray | None = None
+    lod_level: np.ndarray | None = None
 
     @property
     def frames(self) -> int:
@@ -128,7 +135,9 @@ class Recording:
                          orientation=self.orientation[:frames], feet=self.feet[:frames],
                          in_stance=self.in_stance[:frames], swing_phase=self.swing_phase[:frames],
                          joint_angles=self.joint_angles[:frames], ik_on=self.ik_on[:frames],
-                         events=self.events[keep])
+                         events=self.events[keep],
+                         **{key: None if getattr(self, key) is None else getattr(self, key)[:frames]
+                            for key in ("foot_yaw", "speed", "lod_level")})
 
 
 def load_recording(path: str | Path) -> Recording:
@@ -169,8 +178,10 @@ def load_recording(path: str | Path) -> Recording:
     if not (isinstance(columns, list) and "frame" in columns):
         raise InputError(path, "header.event_columns", "expected a list of column names including 'frame'")
 
-    def array(key: str, trailing: tuple[int | None, ...], dtype) -> np.ndarray:
+    def array(key: str, trailing: tuple[int | None, ...], dtype, optional: bool = False) -> np.ndarray | None:
         if key not in contents:
+            if optional:
+                return None
             raise InputError(path, key, "missing array")
         a = contents[key]
         if a.ndim != 2 + len(trailing) or any(want is not None and got != want
@@ -180,6 +191,10 @@ def load_recording(path: str | Path) -> Recording:
             if a.dtype != np.bool_:
                 raise InputError(path, key, f"expected booleans, got {a.dtype}")
             return a
+        if dtype is int:
+            if not np.issubdtype(a.dtype, np.integer):
+                raise InputError(path, key, f"expected integers, got {a.dtype}")
+            return a.astype(np.int64)
         if not np.issubdtype(a.dtype, np.number):
             raise InputError(path, key, f"expected numbers, got {a.dtype}")
         a = a.astype(np.float64)
@@ -197,9 +212,12 @@ def load_recording(path: str | Path) -> Recording:
         feet=array("feet", (n_legs, 3), float), in_stance=array("in_stance", (n_legs,), bool),
         swing_phase=array("swing_phase", (n_legs,), float),
         joint_angles=array("joint_angles", (n_legs, None), float), ik_on=array("ik_on", (), bool),
-        events=np.zeros((0, len(columns))) if "events" not in contents else contents["events"].astype(np.float64))
-    for key in ("orientation", "feet", "in_stance", "swing_phase", "joint_angles", "ik_on"):
-        if getattr(recording, key).shape[:2] != (frames, characters):
+        events=np.zeros((0, len(columns))) if "events" not in contents else contents["events"].astype(np.float64),
+        foot_yaw=array("foot_yaw", (n_legs,), float, optional=True), speed=array("speed", (), float, optional=True),
+        lod_level=array("lod_level", (), int, optional=True))
+    for key in ("orientation", "feet", "in_stance", "swing_phase", "joint_angles", "ik_on", "foot_yaw", "speed",
+                "lod_level"):
+        if getattr(recording, key) is not None and getattr(recording, key).shape[:2] != (frames, characters):
             raise InputError(path, key, f"expected {frames} frames x {characters} characters like 'pelvis', "
                              f"got shape {getattr(recording, key).shape}")
     if recording.joint_angles.shape[3] < 3:
