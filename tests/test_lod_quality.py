@@ -20,7 +20,7 @@ from conftest import fresh_seeds
 from planner._counters import CONTACT_TOLERANCE_M
 from planner._crowd import init_crowd
 from planner._kernels_controller import count_body_overlaps, count_collisions
-from planner._lod import LEVEL_NAMES, LodConfig
+from planner._lod import LEVEL_HIDDEN, LEVEL_NAMES, LodConfig
 from planner._simulation import Recorder, simulate
 from planner._timing import stride_frequency
 from reports._animation import joint_positions
@@ -152,6 +152,12 @@ def test_the_reports_lod_quality_columns_are_what_the_recording_shows(tmp_path, 
     assert set(levels["levels"]) == set(LEVEL_NAMES), where
     assert switches >= 5, where
     assert sum(mine[k]["feet_in_boxes"] for k in range(len(LEVEL_NAMES))) > 0, where
+
+    # Off screen the IK is skipped (the paper's Table 1, LOD zoomed): a hidden character is drawn with
+    # straight legs to its planned feet, every shown one is solved.
+    hidden = recording.lod_level == LEVEL_HIDDEN
+    assert not recording.ik_on[hidden].any(), where
+    assert recording.ik_on[~hidden].all(), where
 
     assert levels["switches"] == switches, where
     assert levels["pop_max_m"] == pytest.approx(pop, abs=RECORDING_TOL_M), where
