@@ -96,9 +96,11 @@ class Recorder:
             "ik_on": np.zeros((frames, c), np.bool_),
             # What the metering of a run reads besides the pose, so that its figures can be recomputed
             # from the file: the yaw each foot was planned with (the foot's rectangle), the body's
-            # commanded speed (the stride meter's 'steady'), and with a LOD mode each character's level.
+            # commanded speed (the stride meter's 'steady': in float64, as a speed that ramps in steps
+            # of acceleration x dt lands on the meter's bounds, 0.5 and 1.5 x goal, within float32's
+            # rounding), and with a LOD mode each character's level.
             "foot_yaw": np.zeros((frames, c, l), np.float32),
-            "speed": np.zeros((frames, c), np.float32),
+            "speed": np.zeros((frames, c), np.float64),
             "stage_seconds": np.zeros((frames, len(STAGES)), np.float64),
         }
         if state.lod_level is not None:
