@@ -66,10 +66,8 @@ from planner._params import PlannerConfig, SearchBudget
 from planner._weights import ScoringWeights
 
 DT = 1.0 / 30.0
-TRANSITION_RATE = 0.5
 ESCAPE_FROUDE = 0.5
 """The Froude number of a creature's top speed (issue 13: every creature walks up to Fr 0.5)."""
-"""Cycles of phase per second a disk moves during a gait change with speed (a new gait within a stride)."""
 STANCE_SLACK_FRAMES = 1.0
 """Frames of the body's travel kept free at the rear end of a stance window (planner._workspace.stance_centres)."""
 STAGES = ("steer", "gait", "swing", "requests", "maps", "plan", "pelvis", "ik")
@@ -1650,7 +1648,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         trajectories=np.repeat(feet[:, :, None, :], K, axis=2), swing_target=feet.copy(),
         plan_heading=np.repeat(headings[:, None], L, axis=1), plan_speed=np.zeros((n, L)),
         feet_spacing=np.ones(n), plan_spacing=np.ones((n, L)), foot_yaws=yaws,
-        gaits=init_gaits([schedule.gaits[int(k)] for k in gait_index], n, rng.uniform(0.0, 1.0, n), transition_rate=TRANSITION_RATE), angles=angles, residual=np.zeros((n, L)),
+        gaits=init_gaits([schedule.gaits[int(k)] for k in gait_index], n, rng.uniform(0.0, 1.0, n)), angles=angles, residual=np.zeros((n, L)),
         ik_on=np.zeros(n, np.bool_), fk_feet=feet.copy(), pelvis_base=np.zeros(n), pelvis_rise=np.zeros(n), body_held=np.zeros(n, np.bool_), speed_limit=np.full(n, np.inf), last_move=np.zeros((n, 2)), cannot_follow=np.zeros((n, L), np.bool_), unfollowed=np.zeros((n, L), np.bool_), pose_before=np.zeros((n, 7)),
         gait_index=gait_index, stride_frequency=np.zeros(n), turn_wanted=np.zeros(n),
         threatened=np.zeros((n, L), np.bool_), tucked=np.zeros((n, L), np.bool_),
