@@ -214,7 +214,7 @@ def _cone_line(px, py, vx, vy, r, tau, dt, share, ax, ay, out_point, out_dir, k)
 @nb.njit(cache=True, parallel=True)
 def orca_velocities(positions, velocities, preferred, radii, max_speed, neighbour_start, neighbour_index,
                     box_centres, box_half, box_yaws, box_velocities, box_active, box_pad, time_horizon,
-                    box_time_horizon, dt, priority, out):
+                    box_time_horizon, dt, priority, mobile, out):
     """New velocity (C, 2) of every character: closest to ``preferred`` among those that avoid
     every neighbour for ``time_horizon`` seconds (sharing the effort) and every active box for
     ``box_time_horizon`` seconds (alone), at most ``max_speed``.
@@ -224,7 +224,9 @@ def orca_velocities(positions, velocities, preferred, radii, max_speed, neighbou
     boxes: centres (B, 2), half extents (B, 2) along their axes, yaws (B,), velocities (B, 2),
     ``box_active`` (B,) bool, ``box_pad`` (B,) m added to a character's radius against that box;
     ``priority`` (C,) bool: between a character with priority and one without, the one without
-    takes the whole effort of avoiding (between equals, each takes half).
+    takes the whole effort of avoiding (between equals, each takes half); ``mobile`` (C,) bool: a
+    character that cannot make way (false: a walker standing still, which only walks off along its
+    heading and turns slowly) is avoided by the other with its whole effort, as a box would be.
     """
     n = positions.shape[0]
     for c in nb.prange(n):
@@ -267,7 +269,12 @@ def orca_velocities(positions, velocities, preferred, radii, max_speed, neighbou
         n_box_lines = k
         for a in range(neighbour_start[c], neighbour_start[c + 1]):
             j = neighbour_index[a]
-            share = 0.5 if priority[c] == priority[j] else (0.0 if priority[c] else 1.0)
+            if not mobile[j]:
+                share = 1.0
+            elif priority[c] == priority[j]:
+                share = 0.5
+            else:
+                share = 0.0 if priority[c] else 1.0
             _cone_line(positions[j, 0] - pax, positions[j, 1] - paz, vax - velocities[j, 0], vaz - velocities[j, 1],
                        ra + radii[j], time_horizon, dt, share, vax, vaz, points, directions, k)
             k += 1

@@ -15,11 +15,12 @@ TAU = 2.0
 NO_BOXES = (np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), np.zeros((0, 2)), np.zeros(0, np.bool_), np.zeros(0))
 
 
-def _step(pos, vel, pref, radii, vmax, boxes=NO_BOXES, tau=TAU, box_tau=1.0, priority=None):
+def _step(pos, vel, pref, radii, vmax, boxes=NO_BOXES, tau=TAU, box_tau=1.0, priority=None, mobile=None):
     start, index = neighbour_lists(pos, 10.0)
     out = np.empty_like(pos)
     priority = np.zeros(len(pos), np.bool_) if priority is None else priority
-    orca_velocities(pos, vel, pref, radii, vmax, start, index, *boxes, tau, box_tau, DT, priority, out)
+    mobile = np.ones(len(pos), np.bool_) if mobile is None else mobile
+    orca_velocities(pos, vel, pref, radii, vmax, start, index, *boxes, tau, box_tau, DT, priority, mobile, out)
     return out
 
 
@@ -90,6 +91,26 @@ def test_a_character_with_priority_keeps_its_way_and_the_other_takes_the_whole_e
     assert out[1] == pytest.approx([1.0 / 4.0, math.sqrt(3.0) / 4.0], abs=1e-12)
     out = _step(*args, priority=np.array([True, True]))
     assert out[0] == pytest.approx([7.0 / 8.0, -math.sqrt(3.0) / 8.0], abs=1e-12)
+
+
+def test_a_character_steers_round_one_that_cannot_make_way_with_its_whole_effort():
+    # The case above, B standing where it cannot make way (a walker at rest): A takes the whole -u
+    # itself, its line through v + u = (3/4, -sqrt(3)/4) along d, onto which (1, 0) projects at that
+    # point (v + u is the foot of the perpendicular from v, u being perpendicular to d). B, without
+    # priority, still takes its whole share too.
+    pos = np.array([[0.0, 0.0], [2.0, 0.0]])
+    vel = np.array([[1.0, 0.0], [0.0, 0.0]])
+    args = (pos, vel, vel.copy(), np.array([0.5, 0.5]), np.array([2.0, 2.0]))
+    out = _step(*args, priority=np.array([True, False]), mobile=np.array([True, False]))
+    assert out[0] == pytest.approx([3.0 / 4.0, -math.sqrt(3.0) / 4.0], abs=1e-12)
+    assert out[1] == pytest.approx([1.0 / 4.0, math.sqrt(3.0) / 4.0], abs=1e-12)
+    # Whether A can make way does not matter to A's own velocity.
+    out = _step(*args, priority=np.array([True, False]), mobile=np.array([False, True]))
+    assert out[0] == pytest.approx([1.0, 0.0], abs=1e-12)
+    # Between equals the same: half the effort is left to a neighbour only if it can take it.
+    out = _step(*args, mobile=np.array([True, False]))
+    assert out[0] == pytest.approx([3.0 / 4.0, -math.sqrt(3.0) / 4.0], abs=1e-12)
+    assert out[1] == pytest.approx([1.0 / 8.0, math.sqrt(3.0) / 8.0], abs=1e-12)
 
 
 def test_a_free_character_keeps_its_preferred_velocity_capped_at_its_top_speed():

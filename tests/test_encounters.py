@@ -216,6 +216,41 @@ def test_avoidance_keeps_a_forbidden_crate_clear_of_the_body_for_its_horizon(tmp
     assert not avoided[0] and velocity[0] == pytest.approx(-preferred[0])
 
 
+def test_a_character_standing_still_is_avoided_with_the_whole_effort(tmp_path, monkeypatch):
+    # ORCA shares the effort of avoiding between two characters, each taking half (van den Berg et al.
+    # 2011). A walker standing still cannot take its half (it walks off only along its heading and turns
+    # slowly): left half the effort, one spider walked into another standing in its way (mixed, seed
+    # 1121411189: 63 overlapping frames). Walking at its preferred velocity, A's new velocity is v + s u
+    # (s its share of the change u that leaves the velocity obstacle): s = 1 against a standing B, 1/2
+    # once B counts as able to make way (MOBILE_FRACTION 0: any speed).
+    import planner._crowd as crowd
+
+    path = tmp_path / "pair.toml"
+    path.write_text(WORLD.format(name="pair", crate=CRATE.format(centre=[5.0, 5.0], width=0.2, motion=""),
+                                 start=[0.0, 0.0], goal=[3.0, 0.0], speed=0.3))
+    creature = load_creature("spider")
+    model, state = init_crowd(load_scenario(str(path)), creature, gait_schedule(creature), n_characters=2, seed=0)
+    state.pelvis[:, [0, 2]] = [[0.0, 0.0], [1.0, 0.1]]
+    state.heading[:] = [0.0, 0.5 * math.pi]
+    state.speed[:] = [0.3, 0.0]
+    state.body_held[:] = False
+    boxes = (np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), np.zeros(0, np.bool_), np.zeros(0, np.bool_))
+    preferred = np.array([[0.3, 0.0], [0.0, 0.0]])
+
+    def a_velocity():
+        # to_target under the keep-right distance: A's preferred velocity is its velocity.
+        velocity, avoided = crowd._avoid(model, state, preferred, np.array([0.5, 0.5]), boxes, np.zeros((0, 2)),
+                                         np.zeros(2, np.bool_))
+        assert avoided[0]
+        return velocity[0] - preferred[0]
+
+    whole = a_velocity()
+    monkeypatch.setattr(crowd, "MOBILE_FRACTION", 0.0)
+    half = a_velocity()
+    assert np.hypot(*half) > 1e-3  # the premise: B is in A's way
+    assert whole == pytest.approx(2.0 * half, abs=1e-12)
+
+
 def test_feet_feedback_shifts_the_pelvis_by_the_gain_of_a_significant_offset(tmp_path):
     # Paper §5, Fig. 7: when the chosen footprints sit on average off the preferred ones by
     # more than the threshold, the pelvis moves toward them at feedback_gain per second.
