@@ -79,7 +79,7 @@ def _recompute(recording, creature, model, start, goal):
     anchor = rendered[0].copy()
     last = {}  # (character, leg) -> (frame, foot xz, pelvis xz, speed) of its last landing
     obstacles = model.raster.obstacles
-    half = creature.body_box
+    body = creature.body_box
     for k in range(1, f + 1):
         r, was = rendered[k], k - 1
         jump = np.linalg.norm((r - rendered[was]) - (planned[k] - planned[was]), axis=-1).max(axis=1)
@@ -99,8 +99,8 @@ def _recompute(recording, creature, model, start, goal):
                          np.ascontiguousarray(obstacles.forbidden, dtype=np.bool_), in_boxes, CONTACT_TOLERANCE_M)
         overlaps = np.zeros(c, np.int64)
         count_body_overlaps(np.ascontiguousarray(recording.pelvis[was][:, [0, 2]]),
-                            np.ascontiguousarray(recording.orientation[was][:, 0]), 0.5 * float(half[0]),
-                            0.5 * float(half[1]), overlaps)
+                            np.ascontiguousarray(recording.orientation[was][:, 0]), 0.5 * float(body[0]),
+                            0.5 * float(body[1]), overlaps)
         drawn = recording.ik_on[was]
         for ch in range(c):
             row = out[int(level[k, ch])]
