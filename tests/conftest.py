@@ -56,34 +56,7 @@ def pytest_report_header(config):
 # to compile, and every process that meets them cold compiles them itself: both xdist workers at once,
 # and every CLI subprocess a test starts meanwhile (on 2 cores, 2.8 compiles' worth of CPU: the suite
 # took 5:14 on a fresh clone against 3:48 warm). So the controller compiles them once, in a short
-# run, before it starts the workers; warm, this run costs about 3 s. A second run beside it, on the
-# other core, compiles the kernels the crowd's run leaves out and the tests use (the serial batch
-# planner, the far level's two-bone IK and maps, the tuning harvest): the workers compiled those
-# themselves, each (with every kernel cached the suite ran 36 s faster on a 1.5x slower machine).
-WARM_UP_RUNS = (
-    ("-m", "footfall.cli", "simulate", "mixed", "--frames", "3", "--characters", "4", "--json"),
-    ("-c", """
-from planner import harvest_situations
-from planner._batch import plan_batch
-from planner._crowd import init_crowd, step
-from planner._lod import LodConfig
-from scenarios import load_creature, load_scenario
-from scenarios._gait_schedule import gait_schedule
-
-scenario, creature = load_scenario("mixed"), load_creature("spider")
-model, state = init_crowd(scenario, creature, gait_schedule(creature), n_characters=4, seed=0, lod_mode="off")
-while state.last_batch is None:
-    step(model, state)
-plan_batch(state.last_batch, model.weights, model.config, parallel=False)
-far = LodConfig(near_m=0.0, far_m=0.01, hysteresis_m=0.0)
-model, state = init_crowd(scenario, creature, gait_schedule(creature), n_characters=4, seed=0, lod_mode="on", lod=far)
-for _ in range(3):
-    step(model, state)
-harvest_situations(frames=2, n_characters=2, max_situations=4)
-"""),
-)
-
-
+# run, before it starts the workers; warm, this run costs about 3 s.
 @pytest.hookimpl(tryfirst=True)
 def pytest_sessionstart(session):
     import subprocess
@@ -92,15 +65,10 @@ def pytest_sessionstart(session):
     if os.environ.get("PYTEST_XDIST_WORKER") or session.config.getoption("collectonly", False):
         return
     started = time.perf_counter()
-    runs = [subprocess.Popen([sys.executable, *args], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-            for args in WARM_UP_RUNS]
-    failed = []
-    for run in runs:
-        _, err = run.communicate(timeout=900)
-        if run.returncode != 0:  # the tests will say what is wrong, one by one
-            failed.extend(err.strip().splitlines()[-1:])
-    if failed:
-        print(f"footfall: the kernels' warm-up runs failed ({failed})")
+    proc = subprocess.run([sys.executable, "-m", "footfall.cli", "simulate", "mixed", "--frames", "3",
+                           "--characters", "4", "--json"], capture_output=True, text=True, timeout=900)
+    if proc.returncode != 0:  # the tests will say what is wrong, one by one
+        print(f"footfall: the kernels' warm-up run failed ({proc.stderr.strip().splitlines()[-1:]})")
     elif time.perf_counter() - started > 10:
         print(f"footfall: compiled the numba kernels once ({time.perf_counter() - started:.0f} s)")
 
