@@ -24,6 +24,9 @@ import numpy as np
 from footfall._errors import InputError
 from planner._simulation import RECORDING_FORMAT, RECORDING_VERSION
 
+OPTIONAL_ARRAYS = ("foot_yaw", "speed", "lod_level")
+"""Per-frame arrays a recording may lack (written before they were kept; ``lod_level`` with LOD off)."""
+
 
 @dataclass(frozen=True, eq=False)
 class Recording:
@@ -137,7 +140,7 @@ class Recording:
                          joint_angles=self.joint_angles[:frames], ik_on=self.ik_on[:frames],
                          events=self.events[keep],
                          **{key: None if getattr(self, key) is None else getattr(self, key)[:frames]
-                            for key in ("foot_yaw", "speed", "lod_level")})
+                            for key in OPTIONAL_ARRAYS})
 
 
 def load_recording(path: str | Path) -> Recording:
@@ -215,8 +218,7 @@ def load_recording(path: str | Path) -> Recording:
         events=np.zeros((0, len(columns))) if "events" not in contents else contents["events"].astype(np.float64),
         foot_yaw=array("foot_yaw", (n_legs,), float, optional=True), speed=array("speed", (), float, optional=True),
         lod_level=array("lod_level", (), int, optional=True))
-    for key in ("orientation", "feet", "in_stance", "swing_phase", "joint_angles", "ik_on", "foot_yaw", "speed",
-                "lod_level"):
+    for key in ("orientation", "feet", "in_stance", "swing_phase", "joint_angles", "ik_on") + OPTIONAL_ARRAYS:
         if getattr(recording, key) is not None and getattr(recording, key).shape[:2] != (frames, characters):
             raise InputError(path, key, f"expected {frames} frames x {characters} characters like 'pelvis', "
                              f"got shape {getattr(recording, key).shape}")
