@@ -92,15 +92,35 @@ def ground_height(scene, x: np.ndarray, z: np.ndarray) -> np.ndarray:
     return h[row, col]
 
 
+# A unit cube's corners (x, y, z in {-1/2, 1/2}) and its six quads, outward.
+_CUBE_CORNERS = 0.5 * np.array([[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1],
+                                [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]], dtype=np.float64)
+_CUBE_QUADS = np.array([[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [3, 7, 6, 2], [0, 4, 7, 3], [1, 2, 6, 5]])
+
+
+def box_corners(centres, sizes, yaws) -> np.ndarray:
+    """The 8 corners of each box, (B, 8, 3): a box's local x is world (cos yaw, 0, sin yaw), its local
+    z is world (-sin yaw, 0, cos yaw) (a turn of -yaw about +y)."""
+    centres, sizes, yaws = (np.asarray(a, dtype=np.float64) for a in (centres, sizes, yaws))
+    local = _CUBE_CORNERS[None] * sizes[:, None, :]
+    cos, sin = np.cos(yaws)[:, None], np.sin(yaws)[:, None]
+    world = np.empty_like(local)
+    world[..., 0] = cos * local[..., 0] - sin * local[..., 2]
+    world[..., 1] = local[..., 1]
+    world[..., 2] = sin * local[..., 0] + cos * local[..., 2]
+    return world + centres[:, None, :]
+
+
 def _boxes(pv, centres, sizes, yaws, forbidden_flags, forbidden: bool):
-    blocks = []
-    for c, s, yaw, f in zip(centres, sizes, yaws, forbidden_flags):
-        if bool(f) != forbidden:
-            continue
-        cube = pv.Cube(center=tuple(c), x_length=s[0], y_length=s[1], z_length=s[2])
-        # Local x is world (cos yaw, 0, sin yaw): a turn of -yaw about +y (right-handed).
-        blocks.append(cube.rotate_y(-math.degrees(float(yaw)), point=tuple(c)))
-    return pv.merge(blocks) if blocks else None
+    """One mesh of the boxes whose forbidden flag is ``forbidden`` (None if there are none); built
+    with numpy, as the clip draws moving boxes again every frame."""
+    pick = np.asarray(forbidden_flags, dtype=bool) == forbidden
+    if not pick.any():
+        return None
+    corners = box_corners(np.asarray(centres)[pick], np.asarray(sizes)[pick], np.asarray(yaws)[pick])
+    quads = _CUBE_QUADS[None] + 8 * np.arange(len(corners))[:, None, None]
+    faces = np.concatenate([np.full((*quads.shape[:2], 1), 4), quads], axis=2).ravel()
+    return pv.PolyData(corners.reshape(-1, 3), faces)
 
 
 # ----------------------------------------------------------------------------- moving geometry
@@ -231,6 +251,7 @@ class SceneView:
         p.add_mesh(terrain, scalars="height_m", cmap="terrain", clim=(low - 0.35 * span, high + 0.05 * span),
                    show_scalar_bar=False, smooth_shading=True)
         self.plotter = p
+        self._box_meshes = {}  # forbidden flag -> the drawn mesh of those boxes
         if not self.moving_boxes:
             self._add_boxes(scene["box_centres"], scene["box_yaws"])
         self._legend()
@@ -242,10 +263,15 @@ class SceneView:
         s = self.scene
         for forbidden, colour in ((True, FORBIDDEN_COLOUR), (False, SAFE_BOX_COLOUR)):
             boxes = _boxes(self.pv, centres, s["box_sizes"], yaws, s["box_forbidden"], forbidden)
-            name = f"boxes-{forbidden}"
-            if boxes is not None:
-                self.plotter.add_mesh(boxes, color=colour, show_edges=True, edge_color="#333333", opacity=0.9,
-                                      name=name, render=False)
+            if boxes is None:
+                continue
+            shown = self._box_meshes.get(forbidden)
+            if shown is not None:  # moving boxes, a later frame: move the drawn corners (same boxes, same faces)
+                shown.points = boxes.points
+                continue
+            self._box_meshes[forbidden] = boxes
+            self.plotter.add_mesh(boxes, color=colour, show_edges=True, edge_color="#333333", opacity=0.9,
+                                  name=f"boxes-{forbidden}", render=False)
 
     def _legend(self) -> None:
         """The legend as an RGBA overlay (Pillow: VTK's legend box writes each label in its entry's
