@@ -123,6 +123,15 @@ def evaluate_cell(default: dict, preset: dict, style: dict) -> dict:
     return cell
 
 
+def cell_runs(default: dict, preset: dict, style: dict) -> list[dict]:
+    """The cell's runs one by one: which run (spawn, seed) and the metrics its cell is made of, under
+    the defaults and under the preset (stored in the matrix, so a test can replay any run of it)."""
+    keys = (MAIN_METRIC, "collisions") + tuple(STYLE_METRIC[k] for k in style)
+    return [{"spawn": d["spawn"], "seed": d["seed"], "default": {k: d[k] for k in keys},
+             "preset": {k: p[k] for k in keys}}
+            for d, p in zip(default["runs"], preset["runs"], strict=True)]
+
+
 def verdict(name: str, cells: dict, style: dict, weight_change: float) -> tuple[bool, list[str]]:
     """(passes, reasons it does not) of a preset from its cells and its largest relative weight change
     from the defaults (module docstring)."""
@@ -197,7 +206,7 @@ def run_matrix(presets_dir: str | Path, names=None, runs: int = RUNS, terrains=N
                 defaults[key] = event_metrics(setup, ScoringWeights(), targets.timing(), targets, map_tasks)
             say(f"{name} on {terrain}")
             mine = event_metrics(setup, preset.weights, preset.timing or targets.timing(), targets, map_tasks)
-            cells[terrain] = evaluate_cell(defaults[key], mine, style)
+            cells[terrain] = dict(evaluate_cell(defaults[key], mine, style), runs=cell_runs(defaults[key], mine, style))
         w0 = ScoringWeights().to_array()
         w = preset.weights.to_array()
         change = float(np.max(np.abs(w / w0 - 1.0)))
