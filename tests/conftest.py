@@ -58,7 +58,7 @@ def pytest_report_header(config):
 # took 5:14 on a fresh clone against 3:48 warm). So the controller compiles them once, before it
 # starts the workers, in a short run of ``footfall simulate``; warm, this costs about 3 s.
 # numba compiles on one core, and half of that minute is one kernel, the batch planner's parallel
-# loop (plan_feet_parallel, 33 of 66 s on this session's machine). So a second process compiles
+# loop (plan_feet_parallel, 33 of 66 s on a 2-core machine, 2026-11-25). So a second process compiles
 # it from a one-foot batch while the run compiles the rest, and the run's first planning call waits
 # for that process (then loads the kernel from the cache) rather than compiling it too.
 _PLANNER_WARM_UP = """
@@ -97,18 +97,25 @@ def pytest_sessionstart(session):
     if os.environ.get("PYTEST_XDIST_WORKER") or session.config.getoption("collectonly", False):
         return
     started = time.perf_counter()
+    errors = []
     with tempfile.TemporaryDirectory(prefix="footfall-warm-up-") as folder:
         planner_done = os.path.join(folder, "planner-compiled")
-        planner = subprocess.Popen([sys.executable, "-c", _PLANNER_WARM_UP], stdout=subprocess.DEVNULL,
-                                   stderr=subprocess.PIPE, text=True)
-        run = subprocess.Popen([sys.executable, "-c", _RUN_WARM_UP, planner_done], stdout=subprocess.DEVNULL,
-                               stderr=subprocess.PIPE, text=True)
-        planner_err = planner.communicate(timeout=900)[1]
-        open(planner_done, "w").close()  # compiled, or failed: the run goes on either way
-        run_err = run.communicate(timeout=900)[1]
-    for proc, err in ((planner, planner_err), (run, run_err)):
-        if proc.returncode != 0:  # the tests will say what is wrong, one by one
-            print(f"footfall: a warm-up process failed ({err.strip().splitlines()[-1:]})")
+        # stderr into files: a pipe nobody reads while the other process is awaited could fill and block
+        with open(os.path.join(folder, "planner.err"), "w+") as planner_err, \
+                open(os.path.join(folder, "run.err"), "w+") as run_err:
+            planner = subprocess.Popen([sys.executable, "-c", _PLANNER_WARM_UP], stdout=subprocess.DEVNULL,
+                                       stderr=planner_err)
+            run = subprocess.Popen([sys.executable, "-c", _RUN_WARM_UP, planner_done], stdout=subprocess.DEVNULL,
+                                   stderr=run_err)
+            planner.wait(timeout=900)
+            open(planner_done, "w").close()  # compiled, or failed: the run goes on either way
+            run.wait(timeout=900)
+            for proc, err in ((planner, planner_err), (run, run_err)):
+                if proc.returncode != 0:  # the tests will say what is wrong, one by one
+                    err.seek(0)
+                    errors.append(err.read().strip().splitlines()[-1:])
+    for lines in errors:
+        print(f"footfall: a warm-up process failed ({lines})")
     if time.perf_counter() - started > 10:
         print(f"footfall: compiled the numba kernels once ({time.perf_counter() - started:.0f} s)")
 
