@@ -36,6 +36,8 @@ from pathlib import Path
 
 import numpy as np
 
+from reports._box_mesh import box_corners, faces_of
+
 WINDOW = (1024, 720)
 MAX_TERRAIN_SAMPLES = 240  # per side: finer terrain adds nothing at this picture size
 TRACK_LIFT_M = 0.004  # drawn just above the ground so lines are not hidden in it
@@ -90,37 +92,6 @@ def ground_height(scene, x: np.ndarray, z: np.ndarray) -> np.ndarray:
     col = np.clip(np.rint((np.asarray(x) - x0) / cell).astype(int), 0, h.shape[1] - 1)
     row = np.clip(np.rint((np.asarray(z) - z0) / cell).astype(int), 0, h.shape[0] - 1)
     return h[row, col]
-
-
-# A unit cube's corners (x, y, z in {-1/2, 1/2}) and its six quads, outward.
-_CUBE_CORNERS = 0.5 * np.array([[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1],
-                                [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]], dtype=np.float64)
-_CUBE_QUADS = np.array([[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [3, 7, 6, 2], [0, 4, 7, 3], [1, 2, 6, 5]])
-
-
-def box_corners(centres, sizes, yaws) -> np.ndarray:
-    """The 8 corners of each box, (B, 8, 3): a box's local x is world (cos yaw, 0, sin yaw), its local
-    z is world (-sin yaw, 0, cos yaw) (a turn of -yaw about +y)."""
-    centres, sizes, yaws = (np.asarray(a, dtype=np.float64) for a in (centres, sizes, yaws))
-    local = _CUBE_CORNERS[None] * sizes[:, None, :]
-    cos, sin = np.cos(yaws)[:, None], np.sin(yaws)[:, None]
-    world = np.empty_like(local)
-    world[..., 0] = cos * local[..., 0] - sin * local[..., 2]
-    world[..., 1] = local[..., 1]
-    world[..., 2] = sin * local[..., 0] + cos * local[..., 2]
-    return world + centres[:, None, :]
-
-
-def _boxes(pv, centres, sizes, yaws, forbidden_flags, forbidden: bool):
-    """One mesh of the boxes whose forbidden flag is ``forbidden`` (None if there are none); built
-    with numpy, as the clip draws moving boxes again every frame."""
-    pick = np.asarray(forbidden_flags, dtype=bool) == forbidden
-    if not pick.any():
-        return None
-    corners = box_corners(np.asarray(centres)[pick], np.asarray(sizes)[pick], np.asarray(yaws)[pick])
-    quads = _CUBE_QUADS[None] + 8 * np.arange(len(corners))[:, None, None]
-    faces = np.concatenate([np.full((*quads.shape[:2], 1), 4), quads], axis=2).ravel()
-    return pv.PolyData(corners.reshape(-1, 3), faces)
 
 
 # ----------------------------------------------------------------------------- moving geometry
@@ -260,17 +231,23 @@ class SceneView:
         return max(10, int(round(base * self.size[1] / 720)))
 
     def _add_boxes(self, centres, yaws) -> None:
+        """The boxes at these poses, one mesh per colour; moving boxes are drawn again every frame,
+        so a later call only moves the drawn meshes' corners (same boxes, same faces)."""
         s = self.scene
         for forbidden, colour in ((True, FORBIDDEN_COLOUR), (False, SAFE_BOX_COLOUR)):
-            boxes = _boxes(self.pv, centres, s["box_sizes"], yaws, s["box_forbidden"], forbidden)
-            if boxes is None:
+            pick = np.asarray(s["box_forbidden"], dtype=bool) == forbidden
+            if not pick.any():
                 continue
+            corners = box_corners(np.asarray(centres)[pick], np.asarray(s["box_sizes"])[pick],
+                                  np.asarray(yaws)[pick]).reshape(-1, 3)
             shown = self._box_meshes.get(forbidden)
-            if shown is not None:  # moving boxes, a later frame: move the drawn corners (same boxes, same faces)
-                shown.points = boxes.points
+            if shown is not None:
+                shown.points = corners
                 continue
-            self._box_meshes[forbidden] = boxes
-            self.plotter.add_mesh(boxes, color=colour, show_edges=True, edge_color="#333333", opacity=0.9,
+            faces = faces_of(int(pick.sum()))
+            shown = self.pv.PolyData(corners, np.column_stack([np.full(len(faces), 4), faces]).ravel())
+            self._box_meshes[forbidden] = shown
+            self.plotter.add_mesh(shown, color=colour, show_edges=True, edge_color="#333333", opacity=0.9,
                                   name=f"boxes-{forbidden}", render=False)
 
     def _legend(self) -> None:

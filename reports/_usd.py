@@ -45,6 +45,7 @@ import numpy as np
 from footfall._atomic import atomic_path, unwritable_reason
 from footfall._errors import InputError
 from planner._ik import legs_of, rest_pose_angles
+from reports._box_mesh import BOX_CORNERS, faces_of
 from reports._recording import Recording
 
 USD_SUFFIXES = (".usda", ".usdc", ".usd")
@@ -61,12 +62,6 @@ BOX_SAFE_COLOUR = (0.3, 0.6, 0.3)
 TERRAIN_COLOUR = (0.55, 0.5, 0.42)
 BODY_COLOUR = (0.2, 0.2, 0.25)
 FOOTPRINT_COLOUR = (0.9, 0.75, 0.1)
-
-# The 8 corners of a box are numbered x + 2 y + 4 z (x, y, z in {0, 1}); each face lists its
-# corners counter-clockwise seen from outside (USD's default right-handed orientation).
-_BOX_FACES = np.array([[0, 4, 6, 2], [1, 3, 7, 5], [0, 1, 5, 4], [2, 6, 7, 3], [0, 2, 3, 1], [4, 5, 7, 6]])
-_BOX_CORNERS = np.array([[i & 1, (i >> 1) & 1, (i >> 2) & 1] for i in range(8)], dtype=np.float64)
-
 
 # ----------------------------------------------------------------------------- skeleton
 @dataclass(frozen=True, eq=False)
@@ -227,20 +222,20 @@ def leg_mesh(creature, layout: SkeletonLayout, bind: np.ndarray) -> LegMesh:
     half = LEG_HALF_WIDTH_FEET * float(creature.foot_width)
     blocks, joints = [], []
     body = np.array([creature.body_box[0], creature.body_thickness, creature.body_box[1]], np.float64)
-    blocks.append((_BOX_CORNERS - 0.5) * body)
+    blocks.append((BOX_CORNERS - 0.5) * body)
     joints.append(0)
     tips = np.zeros((legs.n_legs, 4), np.int64)
     for leg in range(legs.n_legs):
         hinges = layout.leg_joints[leg, 1:-1]
         for j, joint in enumerate(hinges):
             # the segment runs along its hinge's x axis, from 0 to its length
-            local = (_BOX_CORNERS - [0.0, 0.5, 0.5]) * [legs.segment_lengths[leg, j], 2 * half, 2 * half]
+            local = (BOX_CORNERS - [0.0, 0.5, 0.5]) * [legs.segment_lengths[leg, j], 2 * half, 2 * half]
             blocks.append(np.c_[local, np.ones(8)] @ bind[joint][:, :3])
             joints.append(joint)
-        tips[leg] = 8 * (len(blocks) - 1) + np.flatnonzero(_BOX_CORNERS[:, 0] == 1.0)
+        tips[leg] = 8 * (len(blocks) - 1) + np.flatnonzero(BOX_CORNERS[:, 0] == 1.0)
     n_boxes = len(blocks)
     return LegMesh(points=np.concatenate(blocks), face_counts=np.full(6 * n_boxes, 4),
-                   face_indices=(_BOX_FACES[None] + 8 * np.arange(n_boxes)[:, None, None]).ravel(),
+                   face_indices=faces_of(n_boxes).ravel(),
                    joint_indices=np.repeat(joints, 8), tips=tips)
 
 
