@@ -246,6 +246,10 @@ class CrowdState:
     turn_wanted: np.ndarray  # (C,) rad, the turn the steering asked of the last frame, before the stance feet bound it
     threatened: np.ndarray  # (C, L) bool: a moving box reaches the stance foot within the threat horizon
     tucked: np.ndarray  # (C, L) bool: a threatened foot with no footprint, held up near its hip (tuck_swings)
+    escaping: np.ndarray  # (C,) bool: the last steer stage turned the character out of a moving box's lane
+    goal_speed: np.ndarray  # (C,) m/s: the speed the last steer stage headed for (0 at the goal; braking before it)
+    blocks_escape: np.ndarray  # (C, L) bool: a stance foot that stops an escaping character's turn
+    crossed: np.ndarray  # (C, L, L) bool: pairs of legs drawn crossed at the end of the last frame
     counters: dict = field(default_factory=dict)
     last_plans: object = None  # (chars, legs, kinds, BatchResult) of the last frame, for recordings
     last_batch: object = None  # the FootBatch planned in the last frame (what the tuning harvest re-scores)
@@ -349,6 +353,7 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
     # stop within the arrive radius; braking only once inside it overshot the goal by a metre at a trot.
     braking = np.where(state.route_index == last, arrival_speed(dist, ctl.arrive_radius, ctl.acceleration), np.inf)
     goal_speed = np.where(arrived, 0.0, np.minimum(np.minimum(state.desired_speed, state.speed_limit), braking))
+    state.goal_speed = goal_speed
     preferred = direction * goal_speed[:, None]
     velocity, avoided = _avoid(model, state, preferred, dist, boxes, box_velocity, in_lane)
     fast = np.hypot(velocity[:, 0], velocity[:, 1]) > 1e-6
@@ -365,6 +370,7 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
     rate = ctl.turn_rate * dt * np.clip(4.0 * state.speed / np.maximum(goal_speed, 1e-9), 0.25, 1.0)
     # Out of a moving box's way: turning fast is the escape (the body walks only along its heading).
     rate = np.where(in_lane, ctl.turn_rate * dt, rate)
+    state.escaping = in_lane
     state.turn_wanted = np.clip(turn, -rate, rate)
     lo, hi = stance_turn_bounds(model, state)
     state.heading = _wrap(state.heading + uncrossing_turn(model, state, np.clip(state.turn_wanted, lo, hi)))
@@ -893,14 +899,21 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, fre
     # (stance_speed_cap holds the body back), and its sector may be a cycle away.
     # A stance foot that holds the body under half its goal speed (stance_speed_cap) steps now too:
     # waiting for its sector, with the body slow and the needle slower, would freeze the walk.
-    goal = np.minimum(state.desired_speed, state.speed_limit)[:, None]
+    # A body at its goal (the steering's goal speed 0) does not move on: its feet need no room. Asked
+    # for the walk's speed there, a spider at rest stepped one foot back and forth for good between a
+    # spot past the rear of its window and one that capped the speed it was not going to walk.
+    goal = state.goal_speed[:, None]
     room, lift = stance_room(model, state), until_lift(model, state)
-    far |= cannot_follow | (room <= 0.0) | (leg_speed_caps(model, state, room, lift) < 0.5 * goal)
+    far |= cannot_follow | ((room <= 0.0) & (goal > 0.0)) | (leg_speed_caps(model, state, room, lift) < 0.5 * goal)
     # So does a stance foot that stops the body's turn (stance_turn_bounds: no room left), or holds the
     # turn of a slow body under half the turn asked: a body turning on the spot turns by stepping.
     bound, wanted = leg_turn_bounds(model, state, lift), state.turn_wanted[:, None]
     holds_turn = (np.signbit(bound) == (wanted < 0.0)) & ~np.isnan(bound) & (wanted != 0.0)
-    far |= holds_turn & ((bound == 0.0) | ((np.abs(bound) < 0.5 * np.abs(wanted)) & ~walking[:, None]))
+    stops_turn = holds_turn & ((bound == 0.0) | ((np.abs(bound) < 0.5 * np.abs(wanted)) & ~walking[:, None]))
+    far |= stops_turn
+    # Such a foot of a character escaping a moving box's lane that finds no footprint tucks (stage_plan),
+    # as a threatened one does: held, it kept the body from turning out of the lane until the box came.
+    state.blocks_escape = stops_turn & state.escaping[:, None]
     # So does a stance leg the turn asked would carry across another (uncrossing_turn holds the turn).
     far |= turn_crossed_legs(model, state, state.turn_wanted)
     # A stance foot the body turned across another leg steps (its own side again).
@@ -1198,7 +1211,7 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     # every forced step left without a footprint, as a way out of holds, crossed spiders' adjacent
     # legs on the straight way in: 29 -> 51 crossings, crates-moving, 4 runs of 12 x 600 frames.)
     state.tucked[vc, vl] = False
-    tuck = ~out.valid & ((new & state.threatened[cs, ls]) | state.tucked[cs, ls])
+    tuck = ~out.valid & ((new & (state.threatened | state.blocks_escape)[cs, ls]) | state.tucked[cs, ls])
     if tuck.any():
         # A new tuck is a flinch (TUCK_FRAMES); a tucked foot whose re-plan fails goes on as it was.
         left = np.where(new, TUCK_FRAMES * model.dt, state.swing_T[cs, ls] - state.swing_t[cs, ls])
@@ -1338,6 +1351,10 @@ def stage_pelvis(model: CrowdModel, state: CrowdState, smoothing: float | None =
     ``pelvis_lag`` (``smoothing`` 1: none, the first frame's pose)."""
     r = model.raster
     support = np.ascontiguousarray(_landing_feet(state))
+    # A tucked foot lands nowhere: its tuck point, up by the hip, is no support (as one it moved the
+    # body by 5-8 cm, and back in a frame when the foot found a footprint: crates-moving, 12 spiders,
+    # seed 3).
+    lands = state.in_stance | ~state.tucked
     bob = model.controller.bob_factor * model.creature.standing_height * np.sin(4.0 * np.pi * state.gaits.needle)
     if smoothing is None:
         smoothing = -math.expm1(-model.dt / model.controller.pelvis_lag) if model.controller.pelvis_lag > 0 else 1.0
@@ -1347,7 +1364,7 @@ def stage_pelvis(model: CrowdModel, state: CrowdState, smoothing: float | None =
     roll = np.empty_like(y)
     base = np.empty_like(y)
     pelvis_from_hulls(r.static_top, r.frame.origin_x, r.frame.origin_z, r.frame.cell_size, state.pelvis,
-                      state.heading, support, state.in_stance, float(model.creature.body_box[0]),
+                      state.heading, support, state.in_stance, lands, float(model.creature.body_box[0]),
                       float(model.creature.body_box[1]), float(model.creature.standing_height), model.height_range,
                       float(model.creature.body_thickness), bob, float(smoothing), state.pelvis_base, state.pitch, state.roll,
                       y, pitch, roll, base)
@@ -1423,6 +1440,44 @@ def _take_back_unfollowed_poses(model: CrowdModel, state: CrowdState, on_screen:
     bad = failed.any(axis=1)
     if not bad.any():
         return
+    state.body_held[bad] = True
+    state.cannot_follow[bad] |= failed[bad]
+    state.unfollowed[bad] |= failed[bad]
+    _take_back_poses(model, state, bad)
+    state.counters["pose_takebacks"] += int(bad.sum())
+
+
+def _take_back_crossing_poses(model: CrowdModel, state: CrowdState, stance_before: np.ndarray) -> None:
+    """Legs are never drawn crossed by the body's own motion: a body whose new pose (a turn, a move,
+    a tilt) carries two legs that stood through the frame across each other takes the whole frame's
+    pose back (``stage_requests`` then steps the legs the turn it asked would cross:
+    :func:`turn_crossed_legs`). The turn check of the steering (:func:`uncrossing_turn`) sees the
+    straight hip-to-foot lines of the pose before the move; the legs as drawn, with their knees, after
+    the move and the tilt, crossed on turns on the spot (crates-moving, 12 spiders, seed 3).
+    ``stance_before``: the stance feet at the start of the frame. Keeps ``state.crossed``."""
+    from planner._counters import rendered_joints
+    from planner._kernels_controller import crossing_pairs
+
+    n, L = state.in_stance.shape
+    pairs = np.empty((n, L, L), np.bool_)
+    crossing_pairs(np.ascontiguousarray(rendered_joints(model, state)), pairs)
+    stood = state.in_stance & stance_before
+    new = pairs & ~state.crossed & stood[:, :, None] & stood[:, None, :]
+    moved = np.any(_pose(state) != state.pose_before, axis=1)
+    bad = new.any(axis=(1, 2)) & moved
+    if bad.any():
+        _take_back_poses(model, state, bad)
+        redo = np.empty((int(bad.sum()), L, L), np.bool_)
+        crossing_pairs(np.ascontiguousarray(rendered_joints(model, state)[bad]), redo)
+        pairs[bad] = redo
+        state.counters["crossing_takebacks"] += int(bad.sum())
+    state.crossed = pairs
+
+
+def _take_back_poses(model: CrowdModel, state: CrowdState, bad: np.ndarray) -> None:
+    """Characters ``bad`` (C,) bool take the whole frame's pose back (``state.pose_before``), stand,
+    and solve their legs' IK again for it."""
+    ctl = model.controller
     before = state.pose_before[bad]
     state.pelvis[bad] = before[:, :3]
     state.heading[bad] = before[:, 3]
@@ -1430,9 +1485,6 @@ def _take_back_unfollowed_poses(model: CrowdModel, state: CrowdState, on_screen:
     state.roll[bad] = before[:, 5]
     state.pelvis_base[bad] = before[:, 6]
     state.speed[bad] = 0.0
-    state.body_held[bad] = True
-    state.cannot_follow[bad] |= failed[bad]
-    state.unfollowed[bad] |= failed[bad]
     hips = hips_world(model, state)
     for stance, iterations, restarts in ((True, ctl.ik_iterations, ctl.ik_restarts),
                                          (False, ctl.ik_swing_iterations, 0)):
@@ -1443,7 +1495,6 @@ def _take_back_unfollowed_poses(model: CrowdModel, state: CrowdState, on_screen:
         state.angles[cs, ls] = res.angles
         state.residual[cs, ls] = res.residual
         state.fk_feet[cs, ls] = res.feet
-    state.counters["pose_takebacks"] += int(bad.sum())
 
 
 # ----------------------------------------------------------------------------- set-up
@@ -1662,8 +1713,9 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         ik_on=np.zeros(n, np.bool_), fk_feet=feet.copy(), pelvis_base=np.zeros(n), pelvis_rise=np.zeros(n), body_held=np.zeros(n, np.bool_), speed_limit=np.full(n, np.inf), last_move=np.zeros((n, 2)), cannot_follow=np.zeros((n, L), np.bool_), unfollowed=np.zeros((n, L), np.bool_), pose_before=np.zeros((n, 7)),
         gait_index=gait_index, stride_frequency=np.zeros(n), turn_wanted=np.zeros(n),
         threatened=np.zeros((n, L), np.bool_), tucked=np.zeros((n, L), np.bool_),
+        escaping=np.zeros(n, np.bool_), goal_speed=np.full(n, speed), blocks_escape=np.zeros((n, L), np.bool_), crossed=np.zeros((n, L, L), np.bool_),
         counters={k: 0 for k in ("steps", "plans", "holds", "replans", "forbidden_footprints", "cells_expanded",
-                                 "couples_evaluated", "pose_takebacks", "map_cells_built", "ik_ccd_legs", "ik_two_bone_legs")},
+                                 "couples_evaluated", "pose_takebacks", "crossing_takebacks", "map_cells_built", "ik_ccd_legs", "ik_two_bone_legs")},
         lod_level=np.full(n, LEVEL_FULL, np.int8), near_moving_box=np.zeros(n, np.bool_))
     stage_pelvis(model, state, smoothing=1.0)  # the first pose is the hull's own
     state.pelvis_rise[:] = 0.0
@@ -1760,6 +1812,7 @@ def step(model: CrowdModel, state: CrowdState) -> dict[str, float]:
 
     t0 = clock()
     state.pose_before = _pose(state)
+    stance_before = state.in_stance.copy()
     stage_steer(model, state, boxes)
     t1 = clock()
     frequency, enter, _ = stage_gait(model, state)
@@ -1788,6 +1841,7 @@ def step(model: CrowdModel, state: CrowdState) -> dict[str, float]:
     stage_pelvis(model, state)
     t7 = clock()
     stage_ik(model, state, budgets[2])
+    _take_back_crossing_poses(model, state, stance_before)
     t8 = clock()
     for name, (a, b) in zip(STAGES, ((t0, t1), (t1, t2), (t2, t3), (t3, t4), (t4, t5), (t5, t6), (t6, t7),
                                       (t7, t8))):

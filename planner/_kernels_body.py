@@ -77,13 +77,15 @@ def _sample(top, origin_x, origin_z, cell, x, z):
 
 
 @nb.njit(cache=True, parallel=True)
-def pelvis_from_hulls(top, origin_x, origin_z, cell, pelvis, heading, support, in_stance, body_length, body_width,
+def pelvis_from_hulls(top, origin_x, origin_z, cell, pelvis, heading, support, in_stance, lands, body_length, body_width,
                       standing_height, heights, body_thickness, bob, smoothing, last_base, last_pitch, last_roll, out_y,
                       out_pitch, out_roll, out_base):
     """Write pelvis height, pitch, roll and the base height (the pelvis's before the bob).
 
     ``support`` (C, L, 3): the feet used for the hull; ``in_stance`` (C, L): the feet on the ground
     (a swinging foot's landing point lowers no pelvis: the stance legs would have to fold for it);
+    ``lands`` (C, L): the feet that stand or will land (a foot tucked up, with no footprint, is no
+    support point at all: as one it tilted the body by 5 degrees and dropped it by 2.4 cm);
     ``bob`` (C,) the bobbing offset;
     ``heights`` (L, 2) m: the least and most the pelvis stands above each leg's foot along its up
     axis (:func:`planner._workspace.height_ranges`; the least for stance feet only, the most for
@@ -110,15 +112,19 @@ def pelvis_from_hulls(top, origin_x, origin_z, cell, pelvis, heading, support, i
             b = (k - 1) * 0.5 * body_width
             t[k] = b
             yl[k] = _sample(top, origin_x, origin_z, cell, px - b * sn, pz + b * cs)
+        m = 3
         for i in range(n_legs):
+            if not lands[c, i]:
+                continue
             dx = support[c, i, 0] - px
             dz = support[c, i, 2] - pz
-            s[3 + i] = dx * cs + dz * sn
-            y[3 + i] = support[c, i, 1]
-            t[3 + i] = -dx * sn + dz * cs
-            yl[3 + i] = support[c, i, 1]
-        h, slope = upper_hull_at_zero(s, y, n_legs + 3)
-        hl, slope_l = upper_hull_at_zero(t, yl, n_legs + 3)
+            s[m] = dx * cs + dz * sn
+            y[m] = support[c, i, 1]
+            t[m] = -dx * sn + dz * cs
+            yl[m] = support[c, i, 1]
+            m += 1
+        h, slope = upper_hull_at_zero(s, y, m)
+        hl, slope_l = upper_hull_at_zero(t, yl, m)
         # The paper's hull lies in the sagittal slice (Fig. 4b): all feet projected onto the
         # heading. On a side slope that slice's upper hull is the uphill feet, a slope's width above
         # the ground under the body, and the downhill legs cannot reach down that far. The lateral
@@ -139,8 +145,12 @@ def pelvis_from_hulls(top, origin_x, origin_z, cell, pelvis, heading, support, i
         low = -np.inf
         high = np.inf
         reach = np.inf
+        k = 3
         for i in range(n_legs):
-            foot = y[3 + i] - sp * s[3 + i] - cpsr * t[3 + i]
+            if not lands[c, i]:
+                continue
+            foot = y[k] - sp * s[k] - cpsr * t[k]
+            k += 1
             reach = min(reach, foot + cpcr * heights[i, 1])
             if in_stance[c, i]:
                 low = max(low, foot + cpcr * heights[i, 0])

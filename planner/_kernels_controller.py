@@ -197,6 +197,20 @@ def count_polyline_crossings(joints, out):
 
 
 @nb.njit(cache=True, parallel=True)
+def crossing_pairs(joints, out):
+    """Per character, (L, L) bool: the pairs of legs whose rendered ground projections cross
+    (:func:`polylines_cross`), both orders set."""
+    n_chars, n_legs, _, _ = joints.shape
+    for c in nb.prange(n_chars):
+        for i in range(n_legs):
+            out[c, i, i] = False
+            for j in range(i + 1, n_legs):
+                crossed = polylines_cross(joints, c, i, j)
+                out[c, i, j] = crossed
+                out[c, j, i] = crossed
+
+
+@nb.njit(cache=True, parallel=True)
 def stance_legs_crossing(joints, in_stance, out):
     """Per character and leg, a stance leg whose rendered ground projection crosses another leg's
     (:func:`polylines_cross`): a body turning over its stance feet carries them across its other legs."""

@@ -598,3 +598,75 @@ def test_a_quadruped_turning_back_keeps_its_legs_uncrossed(monkeypatch):
     monkeypatch.setattr(crowd, "stance_turn_bounds",
                         lambda model, state: (np.full(state.heading.shape, -np.inf), np.full(state.heading.shape, np.inf)))
     assert sum(turn_back(seed)[0].leg_crossings for seed in (0, 1, 2)) > 0, "a free turn must cross legs here"
+
+
+def test_a_pose_that_draws_two_stood_legs_crossed_is_taken_back():
+    # A spider standing on its eight feet at heading 0, its left front foot (leg 0) put down 1 cm in
+    # front of the next leg's ground line, 40 % of the way from that leg's hip to its foot: no legs
+    # are drawn crossed. Turned right by 0.05 rad in one frame, its hips swing round over feet that
+    # stay, and legs 0 and 1 are drawn crossed (the premise, counted as the counters count them):
+    # the frame's pose is taken back whole (heading, pelvis), and no pair is drawn crossed. Turned
+    # left by 0.05 rad, nothing crosses and the turn is kept; a pair already crossed at the frame's
+    # start, or a leg in the air then, is not the pose's doing and takes nothing back.
+    from planner._counters import count_polyline_crossings, rendered_joints
+    from planner._crowd import _pose, _take_back_crossing_poses, stage_ik
+
+    model, state, (_, _, hips, _) = _standing_on_flat("spider")
+    on = np.ones(1, np.bool_)
+    stance = state.in_stance.copy()
+    state.heading[:] = 0.0
+    hip, foot = hips[0, 1, [0, 2]], state.feet[0, 1, [0, 2]]
+    along = foot - hip
+    front = np.array([along[1], -along[0]]) / np.hypot(*along)  # the line's normal toward +x
+    state.feet[0, 0, [0, 2]] = hip + 0.4 * along + 0.01 * front
+
+    def drawn_crossings():
+        out = np.zeros(1, np.int64)
+        count_polyline_crossings(np.ascontiguousarray(rendered_joints(model, state)), out)
+        return int(out[0])
+
+    def turn_by(angle, crossed_before=False, stance_before=stance):
+        state.heading[0] = 0.0
+        stage_ik(model, state, on)
+        assert drawn_crossings() == 0
+        state.pose_before = _pose(state)
+        state.crossed[:] = crossed_before
+        state.heading[0] = angle
+        stage_ik(model, state, on)
+        crossed = drawn_crossings()
+        _take_back_crossing_poses(model, state, stance_before)
+        return crossed
+
+    pelvis = state.pelvis[0].copy()
+    assert turn_by(-0.05) == 1, "premise: this turn draws two legs crossed"
+    assert state.heading[0] == 0.0 and np.array_equal(state.pelvis[0], pelvis)
+    assert drawn_crossings() == 0 and not state.crossed.any()
+    assert state.counters["crossing_takebacks"] == 1
+    assert turn_by(0.05) == 0 and state.heading[0] == 0.05
+    assert turn_by(-0.05, crossed_before=True) == 1 and state.heading[0] == -0.05
+    assert turn_by(-0.05, stance_before=np.zeros_like(stance)) == 1 and state.heading[0] == -0.05
+    assert state.counters["crossing_takebacks"] == 1
+
+
+def test_a_tucked_foot_is_no_support_for_the_pelvis():
+    # A spider standing on flat ground: its pelvis height, pitch and roll from the hulls of its feet.
+    # One foot tucked up near its hip (a tuck point half the hip's height above the ground) lands
+    # nowhere: on flat ground the other seven give the pose of the eight, to the last bit. Counted as a foot standing at
+    # its tuck point, it moved and tilted the body (checked with the tuck point as support).
+    from planner._crowd import stage_pelvis, tuck_swings
+
+    model, state, (_, _, hips, _) = _standing_on_flat("spider")
+
+    def pose():
+        stage_pelvis(model, state, smoothing=1.0)
+        return state.pelvis[0, 1], state.pitch[0], state.roll[0]
+
+    state.feet[0, :, 1] = 0.0  # every foot on the ground (some of the fixture's stood on a swing's way)
+    standing = pose()
+    assert standing[1:] == (0.0, 0.0)
+    tuck_swings(model, state, np.array([0]), np.array([0]), hips, np.array([0.1]))
+    assert state.swing_target[0, 0, 1] > state.feet[0, 1, 1] + 0.02, "premise: the tuck point is up in the air"
+    assert pose() == standing
+    state.tucked[0, 0] = False  # as a foot landing at its tuck point: the body drops 2.4 cm and tilts
+    y, pitch, roll = pose()
+    assert y < standing[0] - 0.01 and abs(pitch - standing[1]) > 0.05 and abs(roll - standing[2]) > 0.05

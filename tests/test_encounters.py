@@ -385,3 +385,54 @@ def test_a_tucked_foot_rises_first_then_moves_in_to_its_tuck_point(tmp_path):
     assert (np.abs(path[:, third, [0, 2]] - source[:, [0, 2]]) < np.abs(point[:, [0, 2]] - source[:, [0, 2]])).all()
     assert state.tucked[0, legs].all() and not state.in_stance[0, legs].any()
     assert (state.swing_T[0, legs] == 3.0 * model.dt).all(), "a tuck lasts at least three frames: it never lands"
+
+
+def test_a_stance_foot_that_stops_an_escape_and_finds_no_footprint_is_tucked(tmp_path, monkeypatch):
+    # A spider standing still, facing +x, its goal ahead, is told by the steering that it is in a
+    # moving box's lane and must leave it to its left (+z, a turn of +pi/2). Its left front foot stands on the
+    # midline margin (STANCE_SIDE_MARGIN of its hip's offset from the midline): a left turn would carry
+    # it across, so it bounds the turn to 0 and must step. No footprint is found anywhere (every plan
+    # fails). Escaping, the foot is tucked (it leaves the ground, the turn is free of it); not
+    # escaping, it stays down (a hold) and keeps the turn at 0.
+    import planner._crowd as crowd
+    from planner._crowd import STANCE_SIDE_MARGIN, hips_world, leg_turn_bounds
+
+    def run(escaping):
+        model, state = _world(tmp_path, "escape", crate_centre=(5.0, 5.0), crate_width=0.2, start=(0.0, 0.0),
+                              goal=(0.0, 0.0))
+        for _ in range(30):  # every foot down
+            step(model, state)
+        state.heading[:] = 0.0
+        state.route[0] = [4.0, 0.0]  # not at its goal: a character there stops turning
+        hips = hips_world(model, state)
+        leg = int(np.flatnonzero((model.hips_body[:, 0] > 0) & (model.hips_body[:, 2] > 0))[0])
+        state.in_stance[0] = True
+        state.wants_swing[0] = False
+        state.feet[0, leg, 2] = state.pelvis[0, 2] + STANCE_SIDE_MARGIN * model.hips_body[leg, 2]
+        state.feet[0, leg, 0] = max(state.feet[0, leg, 0], hips[0, leg, 0] + 0.05)
+        assert leg_turn_bounds(model, state)[0, leg] == 0.0  # premise: no room for a left turn
+
+        def lane_exit(model, state, direction, boxes, box_velocity):
+            return np.array([[0.0, 1.0]]), np.array([escaping])
+
+        def no_footprint(*args, **kwargs):
+            out, groups = original(*args, **kwargs)
+            out.valid[:] = False
+            return out, groups
+
+        original = crowd._plan_groups
+        monkeypatch.setattr(crowd, "_lane_exit", lane_exit)
+        monkeypatch.setattr(crowd, "_plan_groups", no_footprint)
+        heading = float(state.heading[0])
+        step(model, state)
+        monkeypatch.undo()
+        return state, leg, heading
+
+    state, leg, _ = run(escaping=True)
+    assert state.tucked[0, leg] and not state.in_stance[0, leg]
+    assert state.blocks_escape[0, leg]
+    # Only feet that stop the escape (bound it to 0, or below half the turn asked of a body standing).
+    assert not (state.tucked[0] & ~state.blocks_escape[0]).any()
+    state, leg, heading = run(escaping=False)
+    assert state.in_stance[0, leg] and not state.tucked[0].any()
+    assert state.heading[0] == heading
