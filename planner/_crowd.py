@@ -249,7 +249,7 @@ class CrowdState:
     escaping: np.ndarray  # (C,) bool: the last steer stage turned the character out of a moving box's lane
     goal_speed: np.ndarray  # (C,) m/s: the speed the last steer stage headed for (0 at the goal; braking before it)
     blocks_escape: np.ndarray  # (C, L) bool: a stance foot that stops an escaping character's turn
-    crossed: np.ndarray  # (C, L, L) bool: pairs of legs drawn crossed at the end of the last frame
+    crossed: np.ndarray  # (C, L, L) bool: pairs of stance legs drawn crossed at the end of the last frame
     counters: dict = field(default_factory=dict)
     last_plans: object = None  # (chars, legs, kinds, BatchResult) of the last frame, for recordings
     last_batch: object = None  # the FootBatch planned in the last frame (what the tuning harvest re-scores)
@@ -1458,9 +1458,10 @@ def _take_back_crossing_poses(model: CrowdModel, state: CrowdState, stance_befor
     from planner._counters import rendered_joints
     from planner._kernels_controller import crossing_pairs
 
+    # Only pairs of stance legs: a pair stands through the next frame only if both stand now.
     n, L = state.in_stance.shape
     pairs = np.empty((n, L, L), np.bool_)
-    crossing_pairs(np.ascontiguousarray(rendered_joints(model, state)), pairs)
+    crossing_pairs(np.ascontiguousarray(rendered_joints(model, state)), state.in_stance, pairs)
     stood = state.in_stance & stance_before
     new = pairs & ~state.crossed & stood[:, :, None] & stood[:, None, :]
     moved = np.any(_pose(state) != state.pose_before, axis=1)
@@ -1468,7 +1469,7 @@ def _take_back_crossing_poses(model: CrowdModel, state: CrowdState, stance_befor
     if bad.any():
         _take_back_poses(model, state, bad)
         redo = np.empty((int(bad.sum()), L, L), np.bool_)
-        crossing_pairs(np.ascontiguousarray(rendered_joints(model, state)[bad]), redo)
+        crossing_pairs(np.ascontiguousarray(rendered_joints(model, state)[bad]), state.in_stance[bad], redo)
         pairs[bad] = redo
         state.counters["crossing_takebacks"] += int(bad.sum())
     state.crossed = pairs

@@ -197,15 +197,16 @@ def count_polyline_crossings(joints, out):
 
 
 @nb.njit(cache=True, parallel=True)
-def crossing_pairs(joints, out):
-    """Per character, (L, L) bool: the pairs of legs whose rendered ground projections cross
-    (:func:`polylines_cross`), both orders set."""
+def crossing_pairs(joints, legs, out):
+    """Per character, (L, L) bool: the pairs of legs of ``legs`` (C, L) bool whose rendered ground
+    projections cross (:func:`polylines_cross`), both orders set; pairs with a leg not in ``legs``
+    are False."""
     n_chars, n_legs, _, _ = joints.shape
     for c in nb.prange(n_chars):
         for i in range(n_legs):
             out[c, i, i] = False
             for j in range(i + 1, n_legs):
-                crossed = polylines_cross(joints, c, i, j)
+                crossed = legs[c, i] and legs[c, j] and polylines_cross(joints, c, i, j)
                 out[c, i, j] = crossed
                 out[c, j, i] = crossed
 
