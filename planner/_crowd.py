@@ -1448,9 +1448,9 @@ def _take_back_unfollowed_poses(model: CrowdModel, state: CrowdState, on_screen:
 
 
 def _take_back_crossing_poses(model: CrowdModel, state: CrowdState, stance_before: np.ndarray) -> None:
-    """Legs are never drawn crossed by the body's own motion: a body whose new pose (a turn, a move,
-    a tilt) carries two legs that stood through the frame across each other takes the whole frame's
-    pose back (``stage_requests`` then steps the legs the turn it asked would cross:
+    """Two legs that stand through a frame are never drawn crossed by the body's own motion: a body
+    whose new pose (a turn, a move, a tilt) carries two such legs across each other takes the whole
+    frame's pose back (``stage_requests`` then steps the legs the turn it asked would cross:
     :func:`turn_crossed_legs`). The turn check of the steering (:func:`uncrossing_turn`) sees the
     straight hip-to-foot lines of the pose before the move; the legs as drawn, with their knees, after
     the move and the tilt, crossed on turns on the spot (crates-moving, 12 spiders, seed 3).
