@@ -1465,7 +1465,9 @@ def _take_back_crossing_poses(model: CrowdModel, state: CrowdState, stance_befor
     stood = state.in_stance & stance_before
     new = pairs & ~state.crossed & stood[:, :, None] & stood[:, None, :]
     moved = np.any(_pose(state) != state.pose_before, axis=1)
-    bad = new.any(axis=(1, 2)) & moved
+    # Legs drawn by the IK only (as _take_back_unfollowed_poses): an off-screen character's legs are
+    # not drawn, and taking its pose back would solve the IK the level of detail skips.
+    bad = new.any(axis=(1, 2)) & moved & state.ik_on
     if bad.any():
         _take_back_poses(model, state, bad)
         redo = np.empty((int(bad.sum()), L, L), np.bool_)

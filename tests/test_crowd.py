@@ -607,7 +607,8 @@ def test_a_pose_that_draws_two_stood_legs_crossed_is_taken_back():
     # stay, and legs 0 and 1 are drawn crossed (the premise, counted as the counters count them):
     # the frame's pose is taken back whole (heading, pelvis), and no pair is drawn crossed. Turned
     # left by 0.05 rad, nothing crosses and the turn is kept; a pair already crossed at the frame's
-    # start, or a leg in the air then, is not the pose's doing and takes nothing back.
+    # start, or a leg in the air then, is not the pose's doing and takes nothing back; nor is anything
+    # taken back from a character off screen (its legs are not drawn, its IK is skipped).
     from planner._counters import count_polyline_crossings, rendered_joints
     from planner._crowd import _pose, _take_back_crossing_poses, stage_ik
 
@@ -625,7 +626,7 @@ def test_a_pose_that_draws_two_stood_legs_crossed_is_taken_back():
         count_polyline_crossings(np.ascontiguousarray(rendered_joints(model, state)), out)
         return int(out[0])
 
-    def turn_by(angle, crossed_before=False, stance_before=stance):
+    def turn_by(angle, crossed_before=False, stance_before=stance, drawn=True):
         state.heading[0] = 0.0
         stage_ik(model, state, on)
         assert drawn_crossings() == 0
@@ -633,6 +634,7 @@ def test_a_pose_that_draws_two_stood_legs_crossed_is_taken_back():
         state.crossed[:] = crossed_before
         state.heading[0] = angle
         stage_ik(model, state, on)
+        state.ik_on[0] = drawn
         crossed = drawn_crossings()
         _take_back_crossing_poses(model, state, stance_before)
         return crossed
@@ -646,6 +648,11 @@ def test_a_pose_that_draws_two_stood_legs_crossed_is_taken_back():
     assert turn_by(-0.05, crossed_before=True) == 1 and state.heading[0] == -0.05
     assert turn_by(-0.05, stance_before=np.zeros_like(stance)) == 1 and state.heading[0] == -0.05
     assert state.counters["crossing_takebacks"] == 1
+    # Turned 0.4 rad, the legs cross even drawn straight from hip to foot: taken back on screen, kept
+    # off screen.
+    assert turn_by(-0.4) == 1 and state.heading[0] == 0.0 and state.counters["crossing_takebacks"] == 2
+    assert turn_by(-0.4, drawn=False) == 1 and state.heading[0] == -0.4
+    assert state.counters["crossing_takebacks"] == 2
 
 
 def test_a_tucked_foot_is_no_support_for_the_pelvis():

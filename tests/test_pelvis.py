@@ -30,7 +30,8 @@ def _pose(smoothing, last, most=10.0):
     heights = np.tile([0.0, most], (4, 1))
     out = [np.empty(1) for _ in range(4)]
     pelvis_from_hulls(top, -2.5, -2.5, 1.0, np.array([[0.0, 0.4, 0.0]]), np.zeros(1), FEET,
-                      np.ones((1, 4), np.bool_), np.ones((1, 4), np.bool_), 0.2, 0.2, STANDING, heights, THICKNESS, np.zeros(1), smoothing,
+                      np.ones((1, 4), np.bool_), np.ones((1, 4), np.bool_), 0.2, 0.2, STANDING, heights, THICKNESS,
+                      np.zeros(1), smoothing,
                       np.array([last[0]]), np.array([last[1]]), np.array([last[2]]), *out)
     return tuple(float(o[0]) for o in out)
 
