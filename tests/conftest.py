@@ -166,3 +166,35 @@ def footfall_cli(*args, cwd=None):
     finally:
         os.chdir(here)
     return subprocess.CompletedProcess(["footfall", *argv], code, out.getvalue(), err.getvalue())
+
+
+# --------------------------------------------------------------------------- one main job per session
+@pytest.fixture(scope="session")
+def main_job(tmp_path_factory, worker_id):
+    """``(out, summary)`` of one ``footfall run --quick --out OUT --json``, run once per test session.
+
+    The main job's tune and report are the suite's two longest pieces of work; its report is the quick
+    sweep with the recording's renders, which the report's tests read rather than sweep again. With
+    xdist the first worker to ask runs it and the others wait for it (the job itself keeps both cores
+    busy on its local worker processes): a file lock in the folder the workers share."""
+    import fcntl
+    import json
+    import subprocess
+    import sys
+
+    root = tmp_path_factory.getbasetemp()
+    if worker_id != "master":
+        root = root.parent  # the session's folder, shared by its workers
+    out = root / "main-job"
+    result = root / "main-job.result.json"
+    with open(root / "main-job.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not result.exists():
+            env = dict(os.environ, VTK_DEFAULT_OPENGL_WINDOW="vtkEGLRenderWindow")
+            proc = subprocess.run([sys.executable, "-m", "footfall.cli", "run", "--quick", "--out", str(out), "--json"],
+                                  capture_output=True, text=True, timeout=900, env=env)
+            result.write_text(json.dumps({"returncode": proc.returncode, "stdout": proc.stdout,
+                                          "stderr": proc.stderr[-4000:]}))
+    done = json.loads(result.read_text())
+    assert done["returncode"] == 0, done["stderr"]
+    return out, json.loads(done["stdout"])

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import os
 import subprocess
 import sys
 
@@ -11,19 +10,14 @@ import numpy as np
 import pytest
 
 CLI = [sys.executable, "-m", "footfall.cli"]
-HEADLESS = dict(os.environ, VTK_DEFAULT_OPENGL_WINDOW="vtkEGLRenderWindow")
 
 
-@pytest.mark.slow  # the whole main job (about 60 s)
-def test_run_writes_every_output_into_one_folder(tmp_path):
+@pytest.mark.slow  # the whole main job (about 40 s; one run per session, conftest.main_job)
+def test_run_writes_every_output_into_one_folder(main_job):
     from planner import load_preset
     from pxr import Usd, UsdSkel
 
-    out = tmp_path / "out"
-    proc = subprocess.run(CLI + ["run", "--quick", "--out", str(out), "--json"], capture_output=True, text=True,
-                          timeout=900, env=HEADLESS)
-    assert proc.returncode == 0, proc.stderr
-    summary = json.loads(proc.stdout)
+    out, summary = main_job
     assert summary == json.loads((out / "summary.json").read_text())
     assert set(summary["seconds"]) == {"simulate", "tune", "report", "export", "total"}
     # the recording is the simulate step's run

@@ -22,14 +22,15 @@ def run(*args, timeout=600):
 
 
 @pytest.fixture(scope="module")
-def quick(tmp_path_factory):
-    """One quick report for the module: (folder, --json summary). Its wall time is a benchmark, not a test:
+def quick(main_job):
+    """The quick report of the session's main job (``footfall run --quick``: the quick sweep and the
+    recording's renders; conftest.main_job): (folder, summary as ``footfall report --json`` prints it,
+    read back from its ``results.json``). Its wall time is a benchmark, not a test:
     ``python -m benchmarks.report_bench``."""
-    root = tmp_path_factory.mktemp("quick")
-    out = root / "report"
-    proc = run("report", "--quick", "--out", str(out), "--json")
-    assert proc.returncode == 0, proc.stderr
-    return out, json.loads(proc.stdout)
+    job_out, job = main_job
+    out = job_out / "report"
+    summary = {k: v for k, v in json.loads((out / "results.json").read_text()).items() if k != "tasks"}
+    return out, dict(summary, out=str(out), index=job["report"]["index"])
 
 
 def _image_stats(path):
@@ -44,20 +45,20 @@ def _image_stats(path):
 # ----------------------------------------------------------------------------- the quick report
 
 
-@pytest.mark.slow  # the quick report (about 35 s)
+@pytest.mark.slow  # the main job's quick report (conftest.main_job)
 def test_quick_report_writes_a_complete_folder(quick):
     out, summary = quick
     for name in ("index.html", "results.csv", "summary.csv", "paired.csv", "results.json", "pareto.png",
                  "stride.png"):
         assert (out / name).is_file(), name
-    # Nothing but the report beside it: the temporary folder was renamed, not copied.
-    assert sorted(p.name for p in out.parent.iterdir()) == ["report"]
+    # No temporary folder left beside it: it was renamed, not copied.
+    assert not [p.name for p in out.parent.iterdir() if p.name.startswith(".")]
     assert summary["index"] == str(out / "index.html")
     assert summary["recommended_budget"] in {r["setting"] for r in summary["rows"]}
     assert summary["render_errors"] == []
 
 
-@pytest.mark.slow  # the quick report (about 35 s)
+@pytest.mark.slow  # the main job's quick report (conftest.main_job)
 def test_csv_and_json_agree(quick):
     out, summary = quick
     data = json.loads((out / "results.json").read_text())
@@ -90,7 +91,7 @@ def test_csv_and_json_agree(quick):
     assert data["rows"] == summary["rows"]
 
 
-@pytest.mark.slow  # the quick report (about 35 s)
+@pytest.mark.slow  # the main job's quick report (conftest.main_job)
 def test_pareto_front_and_recommended_budget(quick):
     from reports._pareto import COST, LOSS, dominates
 
@@ -117,7 +118,7 @@ def test_pareto_front_and_recommended_budget(quick):
         assert r["paired_cost_ci_low"] <= r[COST] <= r["paired_cost_ci_high"], r["setting"]
 
 
-@pytest.mark.slow  # the quick report (about 35 s)
+@pytest.mark.slow  # the main job's quick report (conftest.main_job)
 def test_lod_section_has_scaling_and_quality_per_level(quick):
     from reports._lod_report import LEVEL_TABLE
 
@@ -137,7 +138,7 @@ def test_lod_section_has_scaling_and_quality_per_level(quick):
         assert (out / name).is_file(), name
 
 
-@pytest.mark.slow  # the quick report (about 35 s)
+@pytest.mark.slow  # the main job's quick report (conftest.main_job)
 def test_exhaustive_search_is_never_beaten(quick):
     out, _ = quick
     data = json.loads((out / "results.json").read_text())
@@ -158,13 +159,13 @@ def test_exhaustive_search_is_never_beaten(quick):
         assert by["budget-cinf-s0.10"][key] == by["lod-off"][key], key
 
 
-@pytest.mark.slow  # the quick report (about 35 s)
+@pytest.mark.slow  # the main job's quick report (conftest.main_job)
 def test_fig13_situation_is_the_crowds_plan(quick):
     _, summary = quick
     assert summary["scenes"] and all(s["heatmap_matches_crowd"] for s in summary["scenes"])
 
 
-@pytest.mark.slow  # the quick report (about 35 s)
+@pytest.mark.slow  # the main job's quick report (conftest.main_job)
 def test_report_pictures_are_not_blank(quick):
     out, summary = quick
     pictures = [out / "pareto.png", out / "stride.png"] + sorted(out.glob("gait_disks_*.png")) \
@@ -175,7 +176,7 @@ def test_report_pictures_are_not_blank(quick):
         assert std > 8.0 and colours > 16 and dark < 0.5, (p.name, std, colours, dark)
 
 
-@pytest.mark.slow  # the quick report (about 35 s)
+@pytest.mark.slow  # the main job's quick report (conftest.main_job)
 def test_index_leads_with_a_short_table_and_keeps_the_full_one_behind_a_toggle(quick):
     out, summary = quick
     page = (out / "index.html").read_text(encoding="utf-8")
@@ -282,7 +283,7 @@ window.addEventListener('load', function () {
 </script>"""
 
 
-@pytest.mark.slow  # the quick report (about 35 s)
+@pytest.mark.slow  # the main job's quick report (conftest.main_job)
 @pytest.mark.skipif(shutil.which("chromium") is None, reason="Debian chromium is not installed")
 def test_every_image_loads_in_headless_chromium(quick, tmp_path):
     out, _ = quick
@@ -306,7 +307,7 @@ def test_every_image_loads_in_headless_chromium(quick, tmp_path):
     assert result["broken"] == []
 
 
-@pytest.mark.slow  # the quick report (about 35 s)
+@pytest.mark.slow  # the main job's quick report (conftest.main_job)
 def test_the_reports_clips_play_in_headless_chromium(quick, tmp_path):
     # The real report page (not a page made for the test): every <video> loads, lasts at least 60 frames
     # (2 s at 30 fps) and shows a picture in its middle; every image is not blank.
@@ -316,14 +317,15 @@ def test_the_reports_clips_play_in_headless_chromium(quick, tmp_path):
     if CHROMIUM is None:
         pytest.skip("Debian chromium is not installed (.ci/run installs it)")
     out, summary = quick
-    page = (out / "index.html").read_text(encoding="utf-8")
+    copy = tmp_path / "copied-report"  # the main job's folder is shared with other tests: it is only read
+    shutil.copytree(out, copy)
+    page = (copy / "index.html").read_text(encoding="utf-8")
     clips = len(re.findall(r"<video ", page))
-    assert clips == len([s for s in summary["scenes"] if s.get("clip")]) >= 1  # one per swept scenario
-    (out / "media-check.html").write_text(page.replace("</body>", MEDIA_SCRIPT + "</body>"), encoding="utf-8")
-    try:
-        media = media_check(out / "media-check.html", tmp_path)
-    finally:
-        (out / "media-check.html").unlink()
+    # one per swept scenario (at least one), and the main job's recording
+    assert (out / "renders" / "recording" / "clip.mp4").is_file()
+    assert clips == len([s for s in summary["scenes"] if s.get("clip")]) + 1 >= 2
+    (copy / "media-check.html").write_text(page.replace("</body>", MEDIA_SCRIPT + "</body>"), encoding="utf-8")
+    media = media_check(copy / "media-check.html", tmp_path)
     assert len(media["videos"]) == clips
     for video in media["videos"]:
         assert "error" not in video, video
@@ -344,6 +346,27 @@ def _one_line_error(proc, *needles):
     for needle in needles:
         assert needle in lines[0]
     assert proc.stdout == ""
+
+
+def test_report_json_prints_what_the_report_returns(tmp_path, monkeypatch):
+    # The quick report's tests read the main job's report (conftest.main_job); the command's own --json
+    # line is what build_report returns, passed its arguments as given.
+    import reports._report
+
+    calls = []
+
+    def build_report(out, **kwargs):
+        calls.append((out, kwargs))
+        return {"index": str(tmp_path / "r" / "index.html"), "rows": [{"setting": "lod-on"}]}
+
+    monkeypatch.setattr(reports._report, "build_report", build_report)
+    proc = footfall_cli("report", "--quick", "flat", "--seed", "3", "--workers", "1", "--out", str(tmp_path / "r"),
+                        "--json")
+    assert proc.returncode == 0, proc.stderr
+    assert json.loads(proc.stdout) == {"index": str(tmp_path / "r" / "index.html"), "rows": [{"setting": "lod-on"}]}
+    ((out, kwargs),) = calls
+    assert str(out) == str(tmp_path / "r") and kwargs["preset"] == "quick" and kwargs["scenarios"] == ("flat",)
+    assert kwargs["seed"] == 3 and kwargs["workers"] == 1 and kwargs["recording"] is None
 
 
 def test_unknown_scenario_is_one_line_and_nothing_is_written(tmp_path):
