@@ -387,6 +387,54 @@ def test_a_tucked_foot_rises_first_then_moves_in_to_its_tuck_point(tmp_path):
     assert (state.swing_T[0, legs] == 3.0 * model.dt).all(), "a tuck lasts at least three frames: it never lands"
 
 
+def test_a_tuck_point_inside_a_box_moves_in_to_the_first_clear_one(tmp_path):
+    # Heading 0 (body forward +x, left +z). A tall box's near face runs along x, on the left, placed
+    # so that the left feet at their first-choice tuck points (TUCK_REACH) would touch it and at the
+    # next ones in would not; then closer, so that every choice touches it but the last.
+    from planner._crowd import TUCK_LIFT, TUCK_REACHES, hips_world, tuck_points
+    from planner._kernels_controller import foot_box_conflict
+
+    model, state = _world(tmp_path, "tuck-box", crate_centre=(5.0, 5.0), crate_width=0.2, start=(0.0, 0.0),
+                          goal=(4.0, 0.0))
+    legs = np.arange(model.n_legs)
+    chars = np.zeros(legs.size, np.int64)
+    left = legs[model.rest_body[:, 1] > 0.0]
+    hips = hips_world(model, state)
+    height = model.creature.standing_height + model.hips_body[legs, 1]
+    half_foot = (0.5 * model.creature.foot_length, 0.5 * model.creature.foot_width)
+
+    def at(reach):
+        rest = model.rest_body[legs]
+        return np.column_stack([hips[0, legs, 0] + reach * (rest[:, 0] - model.hips_body[legs, 0]),
+                                hips[0, legs, 1] - (1.0 - TUCK_LIFT) * height,
+                                hips[0, legs, 2] + reach * (rest[:, 1] - model.hips_body[legs, 2])])
+
+    assert TUCK_REACHES[0] == 0.25 and len(TUCK_REACHES) == 3
+    for clear in (1, 2):
+        width = 4.0
+        # how far each foot reaches along z, its yaw included
+        yaw = state.foot_yaws[0, legs]
+        reach_z = half_foot[0] * np.abs(np.sin(yaw)) + half_foot[1] * np.abs(np.cos(yaw))
+        face = float((at(TUCK_REACHES[clear])[:, 2] + reach_z)[left].max()) + 0.002  # clear by 2 mm
+        boxes = (np.array([[0.0, 0.5, face + 0.5 * width]]), np.array([[width, 1.0, width]]), np.zeros(1),
+                 np.ones(1, np.bool_), np.zeros(1, np.bool_))
+
+        def touches(p, leg):
+            return foot_box_conflict(*p, *half_foot, state.foot_yaws[0, leg], 0.0, *boxes[:4], np.ones(1, np.bool_))
+
+        point = tuck_points(model, state, chars, legs, hips, boxes)
+        # Each foot at its first choice that does not touch the box (else the last).
+        choices = [at(r) for r in TUCK_REACHES]
+        chosen = [next((k for k in range(len(choices)) if not touches(choices[k][leg], leg)), len(choices) - 1)
+                  for leg in legs]
+        np.testing.assert_allclose(point, np.array([choices[k][leg] for leg, k in zip(legs, chosen)]), atol=1e-12)
+        assert clear in chosen, "the case must need the rule up to this choice"
+        assert not any(touches(point[leg], leg) for leg in legs)
+        assert all(k == 0 for leg, k in zip(legs, chosen) if leg not in left), "the right feet stay out"
+    # Without boxes (or with none near), every foot is held at the first choice.
+    np.testing.assert_allclose(tuck_points(model, state, chars, legs, hips), at(TUCK_REACHES[0]), atol=1e-12)
+
+
 def test_a_stance_foot_that_stops_an_escape_and_finds_no_footprint_is_tucked(tmp_path, monkeypatch):
     # A spider standing still, facing +x, its goal ahead, is told by the steering that it is in a
     # moving box's lane and must leave it to its left (+z, a turn of +pi/2). Its left front foot stands on the
