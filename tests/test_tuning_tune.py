@@ -1,5 +1,6 @@
 """Tuning's outer loop and presets (issue 4, items 4-6): a tiny tune run writes a valid preset,
-a killed run resumed gives the same bytes (on local workers and in-process), shipped presets load
+a killed run resumed gives the same bytes (in-process: that local workers harvest and run the exact
+runs as the process does is test_distributed_tuning's; the main job tunes on them), shipped presets load
 for their creature only, and what the shipped presets do on held-out runs."""
 
 import json
@@ -37,7 +38,7 @@ def tiny_runs(tmp_path_factory):
 
     folder = tmp_path_factory.mktemp("tune")
     config = _tiny()
-    whole = tune(config, folder / "whole.json", workers=2)  # on local worker processes
+    whole = tune(config, folder / "whole.json", workers=1)
     killed = tune(config, folder / "killed.json", stop_after=1, workers=1)  # in-process
     after_kill = checkpoint_path(folder / "killed.json").read_text()
     assert not (folder / "killed.json").exists()
