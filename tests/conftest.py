@@ -170,7 +170,7 @@ def footfall_cli(*args, cwd=None):
 
 # --------------------------------------------------------------------------- one main job per session
 @pytest.fixture(scope="session")
-def main_job(tmp_path_factory, worker_id):
+def main_job(tmp_path_factory):
     """``(out, summary)`` of one ``footfall run --quick --out OUT --json``, run once per test session.
 
     The main job's tune and report are the suite's two longest pieces of work; its report is the quick
@@ -183,7 +183,7 @@ def main_job(tmp_path_factory, worker_id):
     import sys
 
     root = tmp_path_factory.getbasetemp()
-    if worker_id != "master":
+    if os.environ.get("PYTEST_XDIST_WORKER"):
         root = root.parent  # the session's folder, shared by its workers
     out = root / "main-job"
     result = root / "main-job.result.json"
