@@ -353,3 +353,27 @@ def test_the_reports_matrix_section_shows_every_preset_its_cells_and_verdict():
     assert f"{cell['main']['default']:.3f} &rarr; {cell['main']['preset']:.3f}" in page
     assert "footfall tune X" in page and "stairs@terrain.rise=0.1,terrain.run=0.3" in page
     assert "No matrix stored" in matrix_section(None)
+
+
+def test_a_clearance_style_starts_from_a_proximity_reference_as_far_as_its_bound():
+    """The proximity goodness min(1, d / proximity_ref_m) saturates at the reference (0.10 m): a style
+    bound of 2 h starts the tune with the reference at 2 h, in metres; no bound, or one inside the
+    reference, starts at the given weights."""
+    import dataclasses
+
+    from planner._weights import W_PROXIMITY_REF, ScoringWeights
+    from tuning._targets import load_tune_targets
+    from tuning._tune_events import style_start
+
+    default = {"weights": list(ScoringWeights().to_array()), "timing": [1.0]}
+    plain = load_tune_targets(None, "spider")
+    assert style_start(default, plain) == default
+    h = plain.leg_length_m
+    far = dataclasses.replace(plain, style={"min_clearance_body_heights": 2.0})
+    start = style_start(default, far)
+    expected = list(default["weights"])
+    expected[W_PROXIMITY_REF] = 2.0 * h  # 0.24 m for the spider (h = 0.12 m)
+    assert start["weights"] == pytest.approx(expected, rel=0, abs=0) and start["timing"] == default["timing"]
+    assert default["weights"][W_PROXIMITY_REF] == 0.10  # the input is not changed
+    near = dataclasses.replace(plain, style={"min_clearance_body_heights": 0.5})  # 0.06 m < 0.10 m
+    assert style_start(default, near) == default
