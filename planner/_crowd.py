@@ -30,7 +30,6 @@ Stages of a frame (timed one by one):
 from __future__ import annotations
 
 import dataclasses
-import itertools
 import math
 import time
 from dataclasses import dataclass, field
@@ -788,18 +787,17 @@ def _with_neighbours_feet(model: CrowdModel, state: CrowdState, cs, own, preferr
     n_chars, n_legs = state.in_stance.shape
     if not model.controller.avoid_others_feet or n_chars < 2 or f == 0:
         return np.ascontiguousarray(own.reshape(-1, 4)), np.arange(f + 1, dtype=np.int64) * k
-    from scipy.spatial import cKDTree
+    from planner._kernels_geometry import points_near
 
-    support = support[..., [0, 2]].reshape(-1, 2)
+    support = np.ascontiguousarray(support[..., [0, 2]].reshape(-1, 2))
     owner = np.repeat(np.arange(n_chars), n_legs)
     radius = model.config.search_radius_m + 2.0 * _foot_room(model)
-    found = cKDTree(support).query_ball_point(preferred, radius, return_sorted=True)
-    sizes = np.fromiter((len(x) for x in found), np.int64, f)
-    near = np.fromiter(itertools.chain.from_iterable(found), np.int64, int(sizes.sum()))
-    foot_of = np.repeat(np.arange(f), sizes)
-    keep = owner[near] != cs[foot_of]  # the other characters' feet only
-    near, foot_of = near[keep], foot_of[keep]
-    counts = np.bincount(foot_of, minlength=f)
+    # The other characters' feet only, ascending (a grid kernel: the k-d tree's lists of lists cost
+    # 3.4 ms a frame for 1000 spiders).
+    found_start, near = points_near(support, owner, np.ascontiguousarray(preferred, dtype=np.float64),
+                                    np.ascontiguousarray(cs, dtype=np.int64), radius)
+    counts = np.diff(found_start)
+    foot_of = np.repeat(np.arange(f), counts)
     legs_start = np.zeros(f + 1, dtype=np.int64)
     np.cumsum(k + counts, out=legs_start[1:])
     legs = np.empty((legs_start[-1], 4))

@@ -207,3 +207,88 @@ def rects_overlap(ax, az, ahx, ahz, ayaw, bx, bz, bhx, bhz, byaw):
         if abs(dx * ux + dz * uz) >= ra + rb - 1e-9:
             return False
     return True
+
+
+GRID_CELLS_MAX = 1 << 22
+"""Cells a :func:`points_near` grid may have at most (its cells grow beyond the radius to fit)."""
+
+
+@nb.njit(cache=True)
+def _bin_points(points, cell, x0, z0, width, height):
+    """(start (cells + 1,), order (N,)): the points sorted by grid cell (row-major, counting sort;
+    within a cell by index), each cell's points ``order[start[k]:start[k + 1]]``."""
+    n = points.shape[0]
+    key = np.empty(n, np.int64)
+    start = np.zeros(width * height + 1, np.int64)
+    for i in range(n):
+        ix = min(max(int((points[i, 0] - x0) / cell), 0), width - 1)
+        iz = min(max(int((points[i, 1] - z0) / cell), 0), height - 1)
+        key[i] = iz * width + ix
+        start[key[i] + 1] += 1
+    for k in range(width * height):
+        start[k + 1] += start[k]
+    fill = start[:-1].copy()
+    order = np.empty(n, np.int64)
+    for i in range(n):
+        order[fill[key[i]]] = i
+        fill[key[i]] += 1
+    return start, order
+
+
+@nb.njit(cache=True)
+def _near_one(points, owner, qx, qz, q_owner, radius, cell, x0, z0, width, height, start, order, out, m):
+    """Points of other owners within ``radius`` of (qx, qz), written to out[m:] unsorted; the new m."""
+    ix = int(math.floor((qx - x0) / cell))
+    iz = int(math.floor((qz - z0) / cell))
+    r_sq = radius * radius
+    for cz in range(max(iz - 1, 0), min(iz + 2, height)):
+        for cx in range(max(ix - 1, 0), min(ix + 2, width)):
+            k = cz * width + cx
+            for a in range(start[k], start[k + 1]):
+                i = order[a]
+                if owner[i] == q_owner:
+                    continue
+                dx = points[i, 0] - qx
+                dz = points[i, 1] - qz
+                if dx * dx + dz * dz <= r_sq:
+                    out[m] = i
+                    m += 1
+    return m
+
+
+@nb.njit(cache=True)
+def points_near(points, owner, queries, query_owner, radius):
+    """(start (Q + 1,), index): for each query point, the points (N, 2) of other owners within
+    ``radius`` (distance <= radius), ascending, in CSR form (query q's are
+    ``index[start[q]:start[q + 1]]``). A grid of cells at least ``radius`` wide: each query looks
+    at its cell and the eight around it."""
+    n = points.shape[0]
+    nq = queries.shape[0]
+    start = np.zeros(nq + 1, np.int64)
+    if n == 0 or nq == 0:
+        return start, np.zeros(0, np.int64)
+    x0 = points[0, 0]
+    x1 = x0
+    z0 = points[0, 1]
+    z1 = z0
+    for i in range(n):
+        x0 = min(x0, points[i, 0])
+        x1 = max(x1, points[i, 0])
+        z0 = min(z0, points[i, 1])
+        z1 = max(z1, points[i, 1])
+    cell = max(radius, 1e-9)
+    while (int((x1 - x0) / cell) + 1) * (int((z1 - z0) / cell) + 1) > GRID_CELLS_MAX:
+        cell *= 2.0
+    width = int((x1 - x0) / cell) + 1
+    height = int((z1 - z0) / cell) + 1
+    bins, order = _bin_points(points, cell, x0, z0, width, height)
+    scratch = np.empty(n, np.int64)
+    for q in range(nq):
+        start[q + 1] = start[q] + _near_one(points, owner, queries[q, 0], queries[q, 1], query_owner[q], radius,
+                                            cell, x0, z0, width, height, bins, order, scratch, 0)
+    index = np.empty(start[nq], np.int64)
+    for q in range(nq):
+        m = _near_one(points, owner, queries[q, 0], queries[q, 1], query_owner[q], radius, cell, x0, z0, width,
+                      height, bins, order, index[start[q]:start[q + 1]], 0)
+        index[start[q]:start[q] + m].sort()
+    return start, index

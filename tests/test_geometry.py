@@ -3,6 +3,9 @@
 import math
 
 import numpy as np
+import pytest
+
+from conftest import fresh_seeds
 
 from planner._kernels_geometry import foot_offsets, rasterise_boxes, segments_cross, supercover_visit
 
@@ -72,3 +75,36 @@ def test_segments_cross():
     assert segments_cross(0, 0, 2, 2, 0, 2, 2, 0)
     assert not segments_cross(0, 0, 1, 1, 2, 2, 3, 3)
     assert not segments_cross(0, 0, 2, 0, 0, 1, 2, 1)
+
+
+# --------------------------------------------------------------------------- points near a query
+def test_points_near_on_a_hand_made_grid():
+    """Five feet of two characters, radius 1 m. A query of character 0 at the origin: character 1's
+    feet 0.5, 1.0 (exactly: included) and 1.0 m away, not the one 1.5 m away, nor its own foot. A
+    query of character 1 at (0, 1): character 0's foot 0.82 m away."""
+    from planner._kernels_geometry import points_near
+
+    points = np.array([[0.5, 0.0], [1.0, 0.0], [0.0, 1.0], [0.0, 1.5], [-0.2, 0.2]])
+    owner = np.array([1, 1, 1, 1, 0])
+    start, index = points_near(points, owner, np.array([[0.0, 0.0], [0.0, 1.0]]), np.array([0, 1]), 1.0)
+    assert start.tolist() == [0, 3, 4] and index.tolist() == [0, 1, 2, 4]
+
+
+@pytest.mark.parametrize("seed", fresh_seeds([0, 1, 2], 3, salt=77))
+def test_points_near_equals_brute_force_on_random_crowds(seed):
+    """Against a plain distance matrix (no grid): random feet of random owners, queries inside and
+    outside their box, radii from a tenth to twice the spread."""
+    from planner._kernels_geometry import points_near
+
+    rng = np.random.default_rng(seed)
+    n, q = int(rng.integers(1, 300)), int(rng.integers(1, 60))
+    points = rng.uniform(-5.0, 5.0, (n, 2))
+    owner = rng.integers(0, 20, n)
+    queries = rng.uniform(-7.0, 7.0, (q, 2))
+    query_owner = rng.integers(0, 20, q)
+    radius = float(rng.uniform(0.1, 20.0))
+    start, index = points_near(points, owner, queries, query_owner, radius)
+    d = np.hypot(*(queries[:, None, :] - points[None, :, :]).transpose(2, 0, 1))
+    for k in range(q):
+        expected = np.flatnonzero((d[k] <= radius) & (owner != query_owner[k]))
+        assert index[start[k]:start[k + 1]].tolist() == expected.tolist(), f"seed {seed}, query {k}"
