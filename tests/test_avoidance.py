@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 
+from conftest import fresh_seeds
 from planner._kernels_avoidance import neighbour_lists, orca_velocities
 
 DT = 1.0 / 30.0
@@ -214,3 +215,18 @@ def test_a_box_pad_widens_the_disc_against_that_box(pad, expected):
     out = _step(np.zeros((1, 2)), np.zeros((1, 2)), np.array([[1.0, 0.0]]), np.array([0.2]), np.array([2.0]),
                 boxes, box_tau=1.0)
     np.testing.assert_allclose(out[0], [expected, 0.0], atol=1e-9)
+
+
+@pytest.mark.parametrize("seed", fresh_seeds([0, 1, 2], 3, salt=78))
+def test_neighbour_lists_equal_brute_force_on_random_crowds(seed):
+    """Against a plain distance matrix: within the radius, the k nearest (ties by index), ascending."""
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 400))
+    pos = rng.uniform(-6.0, 6.0, (n, 2))
+    radius, k = float(rng.uniform(0.2, 15.0)), int(rng.integers(1, 12))
+    start, index = neighbour_lists(pos, radius, max_neighbours=k)
+    d = np.hypot(*(pos[:, None, :] - pos[None, :, :]).transpose(2, 0, 1))
+    for i in range(n):
+        within = np.flatnonzero((d[i] <= radius) & (np.arange(n) != i))
+        nearest = within[np.argsort(d[i, within], kind="stable")[:k]]
+        assert index[start[i]:start[i + 1]].tolist() == sorted(nearest.tolist()), f"seed {seed}, character {i}"
