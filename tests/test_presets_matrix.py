@@ -78,7 +78,7 @@ def test_a_shipped_terrain_preset_beats_the_defaults_at_home_and_loses_nowhere()
 
 
 @pytest.mark.parametrize("name", ["spider-stairs", "quadruped-stairs", "ant-crates", "spider-mixed", "spider-cautious",
-                                  "spider-direct"])
+                                  "spider-surefooted", "spider-direct"])
 def test_a_shipped_preset_differs_from_the_defaults_and_records_its_tune(name):
     from planner import ScoringWeights
     from tuning._matrix import PRESETS

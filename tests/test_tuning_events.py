@@ -377,3 +377,21 @@ def test_a_clearance_style_starts_from_a_proximity_reference_as_far_as_its_bound
     assert default["weights"][W_PROXIMITY_REF] == 0.10  # the input is not changed
     near = dataclasses.replace(plain, style={"min_clearance_body_heights": 0.5})  # 0.06 m < 0.10 m
     assert style_start(default, near) == default
+
+
+def test_the_offset_block_is_off_only_for_a_style_with_a_clearance_bound():
+    """Pulling the feet onto their preferred footprints works against a clearance bound beside boxes;
+    against a slope ceiling or no style, the stride law is kept too."""
+    import dataclasses
+
+    from tuning._targets import load_tune_targets
+    from tuning._tune_events import offset_weight
+
+    plain = load_tune_targets(None, "spider")
+    assert offset_weight(plain) == 1.0
+    assert offset_weight(dataclasses.replace(plain, style={"max_touchdown_slope_rad": 0.03})) == 1.0
+    assert offset_weight(dataclasses.replace(plain, style={"min_distance_ratio": 0.95})) == 1.0
+    assert offset_weight(dataclasses.replace(plain, style={"max_touchdown_slope_rad": 0.03,
+                                                           "min_clearance_body_heights": 2.0})) == 0.0
+    for name, weight in (("cautious", 0.0), ("sure-footed", 1.0), ("direct", 1.0)):
+        assert offset_weight(load_tune_targets(STYLES / f"{name}.toml", "spider")) == weight, name

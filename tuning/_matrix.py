@@ -68,6 +68,9 @@ PRESETS = {
     "spider-cautious": {"creature": "spider", "style": "tuning/data/styles/cautious.toml", "terrains": ("crates", "mixed"),
                         "command": "footfall tune --creature spider --scenarios crates,mixed --targets "
                                    "tuning/data/styles/cautious.toml --out tuning/data/presets/spider-cautious.json"},
+    "spider-surefooted": {"creature": "spider", "style": "tuning/data/styles/sure-footed.toml", "terrains": ("stairs",),
+                          "command": "footfall tune --creature spider --scenarios stairs --targets "
+                                     "tuning/data/styles/sure-footed.toml --out tuning/data/presets/spider-surefooted.json"},
     "spider-direct": {"creature": "spider", "style": "tuning/data/styles/direct.toml", "terrains": ("crates", "mixed"),
                       "command": "footfall tune --creature spider --scenarios crates,mixed --targets "
                                  "tuning/data/styles/direct.toml --out tuning/data/presets/spider-direct.json"},
