@@ -357,8 +357,16 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
     preferred = direction * goal_speed[:, None]
     velocity, avoided = _avoid(model, state, preferred, dist, boxes, box_velocity, in_lane)
     fast = np.hypot(velocity[:, 0], velocity[:, 1]) > 1e-6
-    direction = np.where((avoided & fast)[:, None], velocity / np.maximum(np.hypot(*velocity.T), 1e-12)[:, None],
-                         direction)
+    # Escaping a moving box's lane, ORCA's velocity can point back along the lane, away from the box:
+    # as it crosses behind the character its angle flipped between +2.9 and -2.9 rad and the turn
+    # with it (a spider turned back and forth on the spot for a second, head-on to a crate). Such a
+    # character turns out of the lane, to the side the lane exit chose, and walks only as far along
+    # its heading as ORCA's velocity goes.
+    backward = in_lane & avoided & fast & ((velocity * direction).sum(axis=1) < 0.0)
+    if backward.any():
+        backward &= ~_near_others(model, state, backward)
+    direction = np.where((avoided & fast & ~backward)[:, None],
+                         velocity / np.maximum(np.hypot(*velocity.T), 1e-12)[:, None], direction)
     desired = np.arctan2(direction[:, 1], direction[:, 0])
     turn = _wrap(desired - state.heading)
     # A held body keeps its whole pose (a turn swings the hips away from the stance feet just as a
@@ -379,6 +387,8 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
     # as far along its heading as the avoiding velocity goes (sideways into a neighbour is no way out).
     v_des = np.where(avoided, np.hypot(velocity[:, 0], velocity[:, 1]) * forward,
                      np.where(arrived, 0.0, state.desired_speed * np.maximum(0.3, forward)))
+    along = velocity[:, 0] * np.cos(state.heading) + velocity[:, 1] * np.sin(state.heading)
+    v_des = np.where(backward, np.maximum(along, 0.0), v_des)
     # The speed limit learnt from holds grows back (ControllerConfig: sustainable speed).
     free = ~state.body_held
     state.speed_limit[free] += ctl.limit_recovery * state.desired_speed[free] * dt
@@ -501,6 +511,18 @@ def _lane_exit(model: CrowdModel, state: CrowdState, direction: np.ndarray, boxe
     direction = direction.copy()
     direction[turn] = exit_way[turn] / norm[turn, None]
     return direction, turn
+
+
+def _near_others(model: CrowdModel, state: CrowdState, rows: np.ndarray) -> np.ndarray:
+    """(C,) bool: the characters of ``rows`` (C,) bool with another character within four avoid radii."""
+    from scipy.spatial import cKDTree
+
+    xz = state.pelvis[:, [0, 2]]
+    out = np.zeros(xz.shape[0], np.bool_)
+    idx = np.flatnonzero(rows)
+    counts = cKDTree(xz).query_ball_point(xz[idx], 4.0 * model.avoid_radius, return_length=True)
+    out[idx] = np.asarray(counts) > 1
+    return out
 
 
 def _avoid(model: CrowdModel, state: CrowdState, preferred: np.ndarray, to_target: np.ndarray, boxes,

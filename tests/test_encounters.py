@@ -484,3 +484,46 @@ def test_a_stance_foot_that_stops_an_escape_and_finds_no_footprint_is_tucked(tmp
     state, leg, heading = run(escaping=False)
     assert state.in_stance[0, leg] and not state.tucked[0].any()
     assert state.heading[0] == heading
+
+
+
+
+@pytest.mark.parametrize("neighbour", [False, True])
+def test_an_escape_whose_orca_velocity_points_back_turns_to_the_lane_exits_side(tmp_path, monkeypatch, neighbour):
+    # A spider standing dead centre in the lane of a 0.6 m crate that comes at it along -x, facing it
+    # (heading +x): the lane exit squares its way out of the lane, to one side. ORCA's velocity
+    # (stubbed here) points back along the lane and a little to the other side: as such a velocity
+    # crossed behind the spider its angle flipped between +2.9 and -2.9 rad and the spider turned
+    # back and forth on the spot while the crate came (34 foot-frames on the 1200-frame crates-moving
+    # run). Alone, the spider turns to the exit's side and walks only as far along its heading as
+    # that velocity goes (0: it points back). With a neighbour within four avoid radii, ORCA's
+    # velocity (which knows of it) leads: the spider turns toward it, to the other side.
+    import planner._crowd as crowd
+    from planner._crowd import _boxes_now
+
+    model, state = _world(tmp_path, "back", crate_centre=(1.0, 0.0), crate_width=0.6, start=(0.0, 0.0),
+                          goal=(4.0, 0.0), velocity=(-0.25, 0.0))
+    exits = []
+    lane_exit = crowd._lane_exit
+
+    def recorded_exit(*a, **k):
+        direction, in_lane = lane_exit(*a, **k)
+        exits.append(direction[0].copy())
+        return direction, in_lane
+
+    def back_to_the_other_side(*a, **k):
+        side = np.sign(exits[-1][1])  # the exit's side along z (it squares out of a lane along x)
+        return np.array([[-0.2, -0.02 * side]]), np.array([True])
+
+    monkeypatch.setattr(crowd, "_lane_exit", recorded_exit)
+    monkeypatch.setattr(crowd, "_avoid", back_to_the_other_side)
+    if neighbour:
+        monkeypatch.setattr(crowd, "_near_others", lambda model, state, rows: rows.copy())
+    stage_steer(model, state, _boxes_now(model, state.t))
+    side = np.sign(exits[-1][1])
+    assert state.escaping[0] and side != 0.0 and abs(exits[-1][0]) < 1e-12  # square out of the lane
+    if neighbour:
+        assert np.sign(state.turn_wanted[0]) == -side
+    else:
+        assert np.sign(state.turn_wanted[0]) == side
+        assert state.speed[0] == 0.0
