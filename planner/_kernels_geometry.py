@@ -1,4 +1,5 @@
-"""numba kernels: rasterising boxes, feet and leg segments onto grids.
+"""numba kernels: rasterising boxes, feet and leg segments onto grids, and finding the points near
+others with a grid (:func:`points_near`).
 
 All kernels take the grid placement as (origin_x, origin_z, cell) with the
 convention of :mod:`planner._grid` (rows along z, columns along x).

@@ -68,6 +68,8 @@ def offset_weight(targets) -> float:
     0.016 rad and the per-stride error to 0.104."""
     style = targets.style or {}
     return 0.0 if any(key in style for key in OFFSET_OFF_STYLES) else 1.0
+
+
 GAIN_NOISE_SE = 2.0
 DEFAULT_SCENARIOS = ("stairs", "crates", "hills", "mixed")
 HELDOUT = {
