@@ -55,6 +55,7 @@ from planner._lod import (
     FULL_SEARCH,
     LEVEL_FAR,
     LEVEL_FULL,
+    LEVEL_HIDDEN,
     LodConfig,
     frame_crowd,
     lod_budgets,
@@ -861,7 +862,11 @@ def _stance_unreachable_ahead(model: CrowdModel, state: CrowdState, hips, freque
         every = min(2 * ctl.lookahead_every, ctl.lookahead_frames)
         far = _two_bone_characters(model, state)
         turn = np.where(far, (np.arange(far.size) + state.frame) % every == 0, turn)
-    cs, ls = np.nonzero(state.in_stance & (state.ik_on & turn)[:, None])
+    # A hidden character (LOD, off screen) is looked ahead too, with the two-bone solve: unchecked, its
+    # body walked off a stance foot while hidden, and the first solve on screen missed it by 2-3 cm
+    # (a 27-32 mm slip: crates-moving and mixed, quadrupeds, LOD zoomed).
+    hidden = _hidden_characters(model, state)
+    cs, ls = np.nonzero(state.in_stance & ((state.ik_on | hidden) & turn)[:, None])
     if cs.size == 0:
         return out.copy()
     # Look no further than the foot's own lift-off: a foot whose sector starts within the horizon
@@ -880,8 +885,8 @@ def _stance_unreachable_ahead(model: CrowdModel, state: CrowdState, hips, freque
     # up `hills` at 57 % of its asked speed at Fr 0.05, and every creature lost speed on `stairs`.
     rise = np.maximum(state.pelvis_rise[cs], 0.0)
     shifted[:, 1] += np.minimum((horizon / model.dt) * rise, rise + ahead * np.maximum(np.tan(state.pitch[cs]), 0.0))
-    # A far character (LOD) looks ahead with its own IK, the two-bone solve.
-    two_bone = _two_bone_characters(model, state)[cs]
+    # A far character (LOD) looks ahead with its own IK, the two-bone solve; a hidden one too.
+    two_bone = (_two_bone_characters(model, state) | hidden)[cs]
     for far in (False, True) if two_bone.any() else (False,):
         k = np.flatnonzero(two_bone == far)
         if k.size == 0:
@@ -1472,6 +1477,13 @@ def stage_ik(model: CrowdModel, state: CrowdState, on_screen: np.ndarray) -> Non
             state.fk_feet[cs, ls] = again.feet
     state.ik_on[on_screen] = True
     _take_back_unfollowed_poses(model, state, on_screen)
+
+
+def _hidden_characters(model: CrowdModel, state: CrowdState) -> np.ndarray:
+    """(C,) the characters off screen (LOD: no IK); none without a LOD mode."""
+    if model.lod_mode == "off":
+        return np.zeros(state.pelvis.shape[0], np.bool_)
+    return state.lod_level == LEVEL_HIDDEN
 
 
 def _two_bone_characters(model: CrowdModel, state: CrowdState) -> np.ndarray:
