@@ -433,6 +433,9 @@ AVOID_BOX_HORIZON = 1.5
 """s: ORCA's time horizon against boxes."""
 AVOID_NEIGHBOURS = 10
 """Nearest characters each one avoids (ORCA's usual cap: the rest are further than these)."""
+NEAR_RADII = 4.0
+"""x avoid radius: a character with another this near is among neighbours: it aims KEEP_RIGHT right of
+its way (:func:`_avoid`), and escaping a moving box it follows ORCA's velocity (:func:`_near_others`)."""
 KEEP_RIGHT = 0.1
 """rad: a character with a neighbour near aims this much right of its way; ORCA alone can settle
 in a symmetric standstill (two characters exactly head-on), a shared convention breaks the tie."""
@@ -515,13 +518,14 @@ def _lane_exit(model: CrowdModel, state: CrowdState, direction: np.ndarray, boxe
 
 
 def _near_others(model: CrowdModel, state: CrowdState, rows: np.ndarray) -> np.ndarray:
-    """(C,) bool: the characters of ``rows`` (C,) bool with another character within four avoid radii."""
+    """(C,) bool: the characters of ``rows`` (C,) bool with another character within :data:`NEAR_RADII`
+    avoid radii (the test :func:`_avoid` makes on its neighbour lists, for the few rows asked)."""
     from scipy.spatial import cKDTree
 
     xz = state.pelvis[:, [0, 2]]
     out = np.zeros(xz.shape[0], np.bool_)
     idx = np.flatnonzero(rows)
-    counts = cKDTree(xz).query_ball_point(xz[idx], 4.0 * model.avoid_radius, return_length=True)
+    counts = cKDTree(xz).query_ball_point(xz[idx], NEAR_RADII * model.avoid_radius, return_length=True)
     out[idx] = np.asarray(counts) > 1
     return out
 
@@ -543,7 +547,7 @@ def _avoid(model: CrowdModel, state: CrowdState, preferred: np.ndarray, to_targe
     if index.size:
         rows = np.repeat(np.arange(n), np.diff(start))
         gap = np.hypot(*(xz[index] - xz[rows]).T)
-        near[rows[gap < 4.0 * radius]] = True
+        near[rows[gap < NEAR_RADII * radius]] = True
     if near.any():
         c, s = math.cos(KEEP_RIGHT), math.sin(-KEEP_RIGHT)
         turn = near & (to_target > 1.0)
