@@ -319,6 +319,28 @@ def test_a_character_in_a_crates_lane_heads_square_out_of_it_to_the_nearer_side(
     assert not lane_exit(model, state, way)[1][0]
 
 
+def test_between_two_crates_lanes_the_way_out_leads_away_from_both(tmp_path):
+    # Two 0.5 m crates drive -x at 0.2 m/s: A head-on at (1, 0), B passing beside the spider at (0, 0.6).
+    # The spider stands at (0, 0.05), its way +x. A's nearer side is +z, B's is -z: summed, the two exits
+    # cancel and the way (+x, into A) was kept. Walking at 0.3 m/s (rest radius + threat margin, 0.38 m,
+    # added to each crate's half width, 0.63 m): +x meets A in 0.74 s and is inside B's reach for 1.26 s;
+    # +z stays inside B's reach for 3.15 s; -z leaves it in 0.27 s and meets A only after 1.85 s. So -z.
+    from planner._crowd import _box_velocities, _boxes_now, _lane_exit
+
+    crates = "".join(CRATE.format(centre=list(c), width=0.5, motion='motion = { kind = "velocity", velocity = [-0.2, 0.0] }')
+                     for c in ((1.0, 0.0), (0.0, 0.6)))
+    path = tmp_path / "two.toml"
+    path.write_text(WORLD.format(name="two", crate=crates, start=[-4.0, 0.0], goal=[4.0, 0.0], speed=0.3))
+    model, state = init_crowd(load_scenario(str(path)), load_creature("spider"), gait_schedule(load_creature("spider")),
+                              n_characters=1, seed=0)
+    assert model.rest_radius + model.controller.threat_margin == pytest.approx(0.38, abs=0.005)
+    state.pelvis[0, [0, 2]] = [0.0, 0.05]
+    boxes = _boxes_now(model, state.t)
+    direction, in_lane = _lane_exit(model, state, np.array([[1.0, 0.0]]), boxes, _box_velocities(model, state.t, boxes[0]))
+    assert in_lane[0]
+    np.testing.assert_allclose(direction[0], [0.0, -1.0], atol=1e-12)
+
+
 def test_a_foot_a_wide_crate_leaves_no_footprint_is_tucked_out_of_its_way(tmp_path, monkeypatch):
     # A spider stands at its goal (0, 0) facing +x. A 0.6 m crate slides +x at 0.2 m/s along z = 0.45:
     # it covers z 0.15..0.75, the left feet's spots (about 0.3 m to the left) and their candidate discs
