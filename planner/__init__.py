@@ -28,6 +28,7 @@ from planner._params import (  # noqa: E402
 from planner._presets import PRESET_SCHEMA_VERSION, Preset, load_preset, preset_dict  # noqa: E402
 from planner._search import COUNTERS, RAW_METRICS, CoupleResult, FootQuery, plan_foot, wavefront_distances  # noqa: E402
 from planner._simulation import RECORDING_VERSION, Recorder, SimulationSummary, simulate  # noqa: E402
+from planner._threads import single_threaded  # noqa: E402
 from planner._timing import GaitTiming, duty_factor, stride_frequency, stride_length  # noqa: E402
 from planner._weights import (  # noqa: E402
     FOOTPRINT_TERMS,
@@ -88,6 +89,7 @@ __all__ = [
     "ScoringWeights",
     "SearchBudget",
     "set_destination",
+    "single_threaded",
     "set_speed",
     "simulate",
     "SimulationSummary",

@@ -22,7 +22,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import numba
 import numpy as np
 
 from planner._kernels_foot import N_FEATURES, N_RAW
@@ -31,6 +30,7 @@ from planner._kernels_search import MODE_SEARCH, harvest_foot_kernel, plan_foot_
 from planner._maps import LocalMaps
 from planner._params import DEFAULT_BUDGET, PlannerConfig, SearchBudget
 from planner._search import FootQuery, checked_foot_offsets
+from planner._threads import single_threaded
 from planner._weights import N_FOOTPRINT_TERMS, N_TERMS, ScoringWeights
 
 FEATURES = ("distance_m", "roughness_m", "slope_rad", "leg_gap_m", "obstacle_distance_m")
@@ -311,9 +311,7 @@ def harvest_chunk(task: dict) -> dict:
     # the cores costs more than it saves (x20 on a busy 2-core machine), and the parallel
     # and serial kernels give identical results (tests/test_planner_properties.py). Set here,
     # not by the caller, so a chunk run by any map_tasks gets it.
-    threads = numba.get_num_threads()
-    numba.set_num_threads(1)
-    try:
+    with single_threaded():
         creature = load_creature(task["creature"])
         gait = load_gait(default_gait_name(creature.name), creature)
         cell = planner_config_for(creature).cell_size
@@ -337,8 +335,6 @@ def harvest_chunk(task: dict) -> dict:
             # The global count is at least this chunk's, so the global cap never cuts later than here.
             if cap is not None and len(rows) >= cap:
                 break
-    finally:
-        numba.set_num_threads(threads)
     return {"rows": rows, "frame_ends": frame_ends}
 
 

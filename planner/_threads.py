@@ -16,6 +16,7 @@ Results do not depend on it (every kernel gives the same numbers on any number o
 
 from __future__ import annotations
 
+import contextlib
 import os
 
 
@@ -28,3 +29,30 @@ def configure_worker_wait() -> None:
         loaded = False
     if loaded:
         os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
+
+@contextlib.contextmanager
+def single_threaded():
+    """Run the numba kernels on one thread inside the ``with`` block, and give back the thread count
+    it had on the way out (an exception included).
+
+    A few characters plan a few feet per frame: fanning each small kernel call out over the cores
+    costs more than it saves (x20 on a busy 2-core machine), and one thread leaves the other cores
+    to the other tasks of a sweep. Results do not depend on it.
+
+    >>> import numba
+    >>> before = numba.get_num_threads()
+    >>> with single_threaded():
+    ...     numba.get_num_threads()
+    1
+    >>> numba.get_num_threads() == before
+    True
+    """
+    import numba
+
+    threads = numba.get_num_threads()
+    numba.set_num_threads(1)
+    try:
+        yield
+    finally:
+        numba.set_num_threads(threads)

@@ -169,9 +169,8 @@ def replay_command(task: dict, preset: str = "PRESET.json") -> str:
 
 def run_event_task(task: dict) -> dict:
     """One run of :func:`event_tasks`: the simulation's summary and the plan metrics (picklable)."""
-    import numba
-
     from footfall._runs import resolve_gait
+    from planner import single_threaded
     from planner._crowd import init_crowd
     from planner._simulation import arrived, simulate
     from planner._timing import GaitTiming, hip_height
@@ -184,9 +183,7 @@ def run_event_task(task: dict) -> dict:
     creature = load_creature(task["creature"])
     own = task["creature"] == scenario.crowd.creature
     gait, _, _ = resolve_gait(scenario if own else None, creature)
-    threads = numba.get_num_threads()
-    numba.set_num_threads(1)
-    try:
+    with single_threaded():
         model, state = init_crowd(scenario, creature, gait, n_characters=task["characters"], seed=task["seed"],
                                   weights=weights, timing=timing, lod_mode="off")
         w = weights.to_array()
@@ -223,8 +220,6 @@ def run_event_task(task: dict) -> dict:
                 rough.append((1.0 - out.terms[ok, 1]) * w[W_STEP_CRITICAL])
 
         summary = simulate(model, state, task["frames"], progress=after).to_json()
-    finally:
-        numba.set_num_threads(threads)
 
     def cat(parts):
         return np.concatenate(parts) if parts else np.zeros(0)

@@ -217,20 +217,15 @@ def exact_tasks(setup: ExactSetup, weights=None, timing=None) -> list[dict]:
 def run_exact_task(task: dict) -> dict:
     """:func:`run_one` for a task of :func:`exact_tasks`, tagged with its scenario, seed and speed.
     The result holds numpy arrays (``speed``, ``stride``, ``raw``): picklable, for a worker to send back."""
-    import numba
-
+    from planner import single_threaded
     from planner._timing import GaitTiming
     from planner._weights import ScoringWeights
 
     weights = None if task["weights"] is None else ScoringWeights.from_array(task["weights"])
     timing = GaitTiming.from_array(task["timing"])
-    threads = numba.get_num_threads()
-    numba.set_num_threads(1)  # small crowds: one core is faster and leaves the other to others
-    try:
+    with single_threaded():  # small crowds: one core is faster and leaves the other to others
         r = run_one(task["creature"], task["scenario"], task["seed"], task["speed"], weights, timing, task["frames"],
                     task["warmup"], task["n_characters"])
-    finally:
-        numba.set_num_threads(threads)
     r.update(scenario=task["scenario"], seed=task["seed"], froude=task["froude"], desired_speed=task["speed"])
     return r
 
