@@ -39,7 +39,9 @@ _HELD = ("a crate runs down a character whose body is held by a foot it cannot f
          " (traced on crates-moving, spider)")
 _FEET_IN = "rendered feet inside crates (untraced)"
 _TOP = ("robot5: tucked feet inside a forbidden crate that runs alongside, the body already over its edge (seed"
-        " 1003, 120 foot-frames), and feet planned on a box top the leg cannot reach (reach checked in xz only)")
+        " 1003, 120 foot-frames; on mixed, seeds 1100, 1102, 1105, 1200, 1202, 1208, all 549 foot-frames are tucked"
+        " feet of a robot5 escaping a crate, 193 with the body itself over it), and feet planned on a box top the"
+        " leg cannot reach (reach checked in xz only)")
 _CROSS = "adjacent legs cross while the body turns or is held and the gait swings a neighbour (untraced per seed)"
 _SLIP = ("a foot lands in the frame its body is held and its pose taken back: out of reach, it snaps on 2 frames later"
          " (traced on crates-moving, spider)")
