@@ -29,6 +29,20 @@ app = typer.Typer(no_args_is_help=True, add_completion=False, pretty_exceptions_
 bench_app = typer.Typer(no_args_is_help=True, help="Benchmarks: tables of measured speed.")
 app.add_typer(bench_app, name="bench")
 
+
+def _print_version(show: bool) -> None:
+    if show:
+        from footfall import __version__
+
+        print(f"footfall {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(version: bool = typer.Option(False, "--version", callback=_print_version, is_eager=True,
+                                       help="Print the version (pyproject.toml's) and exit.")) -> None:
+    """footfall: procedural locomotion of multi-legged characters (Abdul Karim et al., CAVW 2012)."""
+
 BUDGET_NAMES = ("first-valid", "default", "exhaustive")
 
 

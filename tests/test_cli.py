@@ -135,6 +135,18 @@ def test_help_shows_flags_as_flags_and_one_line_summaries():
     assert listing and not continued, wide.stdout
 
 
+def test_version_is_the_one_pyproject_declares():
+    import tomllib
+    from pathlib import Path
+
+    import footfall
+
+    declared = tomllib.loads((Path(__file__).resolve().parent.parent / "pyproject.toml").read_text())["project"]["version"]
+    assert footfall.__version__ == declared
+    done = footfall_cli("--version")
+    assert (done.returncode, done.stdout, done.stderr) == (0, f"footfall {declared}\n", "")
+
+
 def test_scenarios_lists_descriptions_creatures_and_gaits():
     proc = run("scenarios")
     assert proc.returncode == 0, proc.stderr

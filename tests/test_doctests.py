@@ -39,3 +39,4 @@ def test_docstring_examples(name):
             runner.run(test, out=failures.append)
     result = runner.summarize(verbose=False)
     assert result.failed == 0, "".join(failures)
+
