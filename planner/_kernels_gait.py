@@ -54,6 +54,8 @@ from planner._timing import (
     T_MIN_FREQUENCY,
     T_STRIDE_COEFFICIENT,
     T_STRIDE_EXPONENT,
+    duty_law,
+    stride_law,
 )
 
 SNAP = 1e-9
@@ -68,8 +70,7 @@ def stride_length_k(params, v, h):
     """Kernel twin of :func:`planner._timing.stride_length` for one speed ``v`` (m/s) and height ``h`` (m)."""
     if v <= 0.0:
         return 0.0
-    froude = v * v / (GRAVITY * h)
-    return params[T_STRIDE_COEFFICIENT] * h * froude ** params[T_STRIDE_EXPONENT]
+    return stride_law(params[T_STRIDE_COEFFICIENT], params[T_STRIDE_EXPONENT], v, h)
 
 
 @nb.njit(cache=True)
@@ -84,7 +85,7 @@ def stride_frequency_k(params, v, h):
 @nb.njit(cache=True)
 def duty_factor_k(params, v, h):
     """Kernel twin of :func:`planner._timing.duty_factor`."""
-    raw = params[T_DUTY_AT_REST] - params[T_DUTY_SLOPE] * v / math.sqrt(GRAVITY * h)
+    raw = duty_law(params[T_DUTY_AT_REST], params[T_DUTY_SLOPE], v, math.sqrt(GRAVITY * h))
     return min(max(raw, params[T_DUTY_MIN]), params[T_DUTY_MAX])
 
 

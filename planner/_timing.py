@@ -44,11 +44,37 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from numba.extending import register_jitable
 
 from planner._flat import FlatParameters
 
 GRAVITY = 9.81
 """g, m/s^2."""
+
+
+# --------------------------------------------------------------------------- the laws, once
+# Each formula of the model is written once, here: plain arithmetic that runs on floats and numpy
+# arrays as written, is compiled into the numba kernels that call it (planner._kernels_gait), and is
+# traced by JAX in the tuning proxies (tuning._proxies). Each caller adds only what its backend does
+# differently: the cases (v = 0), the clips, and the square root of g h.
+
+
+@register_jitable
+def froude_law(v, h):
+    """Fr = v^2 / (g h)."""
+    return v * v / (GRAVITY * h)
+
+
+@register_jitable
+def stride_law(coefficient, exponent, v, h):
+    """lambda = coefficient * h * Fr^exponent (m), for v > 0 (at v = 0 there is no stride)."""
+    return coefficient * h * froude_law(v, h) ** exponent
+
+
+@register_jitable
+def duty_law(at_rest, slope, v, root_gh):
+    """The duty factor before its clip: at_rest - slope * v / sqrt(g h), ``root_gh`` = sqrt(g h)."""
+    return at_rest - slope * v / root_gh
 SWING_MIN = 0.05
 """Least swing fraction of a speed-scaled disk."""
 SWING_MAX = 0.95
@@ -124,7 +150,7 @@ def _out(values: np.ndarray, scalar: bool):
 def froude_number(v, h):
     """Fr = v^2 / (g h)."""
     speed, height, scalar = _speed_height(v, h)
-    return _out(speed * speed / (GRAVITY * height), scalar)
+    return _out(froude_law(speed, height), scalar)
 
 
 def stride_length(timing: GaitTiming, v, h):
@@ -143,9 +169,8 @@ def stride_frequency(timing: GaitTiming, v, h):
 
 def _stride_length(timing: GaitTiming, speed: np.ndarray, height) -> np.ndarray:
     """:func:`stride_length` of speeds already checked (the runtime's per-frame calls skip the checks)."""
-    froude = speed * speed / (GRAVITY * height)
     with np.errstate(divide="ignore"):
-        length = timing.stride_coefficient * height * np.power(froude, timing.stride_exponent)
+        length = stride_law(timing.stride_coefficient, timing.stride_exponent, speed, height)
     # Fr^0 = 1 even at Fr = 0; a creature standing still has no stride.
     return np.where(speed > 0.0, length, 0.0)
 
@@ -162,7 +187,7 @@ def _stride_frequency(timing: GaitTiming, speed: np.ndarray, height) -> np.ndarr
 def duty_factor(timing: GaitTiming, v, h):
     """DF = clip(duty_at_rest - duty_slope * v / sqrt(g h), duty_min, duty_max). Broadcasts ``v`` and ``h``."""
     speed, height, scalar = _speed_height(v, h)
-    raw = timing.duty_at_rest - timing.duty_slope * speed / np.sqrt(GRAVITY * height)
+    raw = duty_law(timing.duty_at_rest, timing.duty_slope, speed, np.sqrt(GRAVITY * height))
     return _out(np.clip(raw, timing.duty_min, timing.duty_max), scalar)
 
 

@@ -80,6 +80,8 @@ from planner._timing import (
     T_MIN_FREQUENCY,
     T_STRIDE_COEFFICIENT,
     T_STRIDE_EXPONENT,
+    duty_law,
+    stride_law,
 )
 from tuning._config import enable_x64
 from tuning._scoring import couple_score
@@ -166,8 +168,7 @@ def stride_length(timing, speed, leg_height):
     """lambda(v) = stride_coefficient * h * Fr^stride_exponent, 0 at v = 0 (planner._timing)."""
     moving = speed > 0.0
     v = jnp.where(moving, speed, 1.0)  # a safe value where v = 0: Fr^b has no derivative in b at Fr = 0
-    froude = v * v / (GRAVITY * leg_height)
-    length = timing[T_STRIDE_COEFFICIENT] * leg_height * froude ** timing[T_STRIDE_EXPONENT]
+    length = stride_law(timing[T_STRIDE_COEFFICIENT], timing[T_STRIDE_EXPONENT], v, leg_height)
     return jnp.where(moving, length, 0.0)
 
 
@@ -181,7 +182,7 @@ def stride_frequency(timing, speed, leg_height):
 
 def duty_factor(timing, speed, leg_height):
     """DF(v) = clip(duty_at_rest - duty_slope * v / sqrt(g h), duty_min, duty_max) (planner._timing)."""
-    raw = timing[T_DUTY_AT_REST] - timing[T_DUTY_SLOPE] * speed / jnp.sqrt(GRAVITY * leg_height)
+    raw = duty_law(timing[T_DUTY_AT_REST], timing[T_DUTY_SLOPE], speed, jnp.sqrt(GRAVITY * leg_height))
     return jnp.clip(raw, timing[T_DUTY_MIN], timing[T_DUTY_MAX])
 
 
