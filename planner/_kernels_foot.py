@@ -38,6 +38,9 @@ from planner._weights import (
     W_PROXIMITY_REF,
     W_SLOPE_CRITICAL,
     W_STEP_CRITICAL,
+    falling_goodness,
+    rational_goodness,
+    rising_goodness,
 )
 
 # Codes of the per-foot obstacles' map (ROI).
@@ -197,21 +200,21 @@ def footprint_features(p, x, z, elev_dil, elev_raw, prox_dt, wp, pref_x, pref_z,
 def footprint_goodness(w, features, terms):
     """Fill ``terms[:5]`` with the footprint goodnesses in [0, 1] of raw features (the one
     definition: the search, the harvest and tuning/_scoring.py follow it term by term)."""
-    terms[0] = max(0.0, 1.0 - features[FEAT_DISTANCE] / w[W_DISTANCE_SCALE])
-    terms[1] = max(0.0, 1.0 - features[FEAT_ROUGHNESS] / w[W_STEP_CRITICAL])
-    terms[2] = max(0.0, 1.0 - features[FEAT_SLOPE] / w[W_SLOPE_CRITICAL])
-    terms[3] = min(1.0, features[FEAT_LEG_GAP] / w[W_LEG_SPACING_REF])
-    terms[4] = min(1.0, features[FEAT_PROXIMITY] / w[W_PROXIMITY_REF])
+    terms[0] = max(0.0, falling_goodness(features[FEAT_DISTANCE], w[W_DISTANCE_SCALE]))
+    terms[1] = max(0.0, falling_goodness(features[FEAT_ROUGHNESS], w[W_STEP_CRITICAL]))
+    terms[2] = max(0.0, falling_goodness(features[FEAT_SLOPE], w[W_SLOPE_CRITICAL]))
+    terms[3] = min(1.0, rising_goodness(features[FEAT_LEG_GAP], w[W_LEG_SPACING_REF]))
+    terms[4] = min(1.0, rising_goodness(features[FEAT_PROXIMITY], w[W_PROXIMITY_REF]))
 
 
 @nb.njit(cache=True)
 def trajectory_goodness(w, terms, d_ref, length, curvature, clearance, climb, jerk):
     """Fill ``terms[5:10]`` with the trajectory goodnesses in [0, 1] of raw trajectory metrics."""
-    terms[N_FOOTPRINT_TERMS + 0] = d_ref / max(length, d_ref)
-    terms[N_FOOTPRINT_TERMS + 1] = 1.0 / (1.0 + curvature / w[W_CURVATURE_REF])
-    terms[N_FOOTPRINT_TERMS + 2] = min(1.0, clearance / w[W_CLEARANCE_REF])
-    terms[N_FOOTPRINT_TERMS + 3] = 1.0 / (1.0 + climb / w[W_CLIMB_REF])
-    terms[N_FOOTPRINT_TERMS + 4] = 1.0 / (1.0 + jerk / w[W_JERK_REF])
+    terms[N_FOOTPRINT_TERMS + 0] = rising_goodness(d_ref, max(length, d_ref))
+    terms[N_FOOTPRINT_TERMS + 1] = rational_goodness(curvature, w[W_CURVATURE_REF])
+    terms[N_FOOTPRINT_TERMS + 2] = min(1.0, rising_goodness(clearance, w[W_CLEARANCE_REF]))
+    terms[N_FOOTPRINT_TERMS + 3] = rational_goodness(climb, w[W_CLIMB_REF])
+    terms[N_FOOTPRINT_TERMS + 4] = rational_goodness(jerk, w[W_JERK_REF])
 
 
 @nb.njit(cache=True)

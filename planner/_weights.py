@@ -35,6 +35,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from numba.extending import register_jitable
 
 from planner._flat import FlatParameters
 
@@ -116,3 +117,29 @@ W_CLEARANCE_REF = WEIGHT_FIELDS.index("clearance_ref_m")
 W_CLIMB_REF = WEIGHT_FIELDS.index("climb_ref_m")
 W_JERK_REF = WEIGHT_FIELDS.index("jerk_ref")
 assert WEIGHT_FIELDS[:N_TERMS] == FOOTPRINT_WEIGHT_FIELDS + TRAJECTORY_WEIGHT_FIELDS
+
+
+# --------------------------------------------------------------------------- the goodness laws, once
+# Each goodness is one of three laws of a raw number and its weight's scale, written here once: the
+# numba kernels compile them (planner._kernels_foot.footprint_goodness, trajectory_goodness), the JAX
+# scoring traces them (tuning._scoring). Each caller adds only its backend's floor or ceiling (and JAX
+# its care for +inf).
+
+
+@register_jitable
+def falling_goodness(value, critical):
+    """1 - value / critical: distance, roughness and slope (floored at 0 by the caller)."""
+    return 1.0 - value / critical
+
+
+@register_jitable
+def rising_goodness(value, reference):
+    """value / reference: leg spacing, obstacle proximity, clearance (capped at 1 by the caller), and
+    directness (the straight distance over the path length, at least the distance)."""
+    return value / reference
+
+
+@register_jitable
+def rational_goodness(value, reference):
+    """1 / (1 + value / reference): curvature, climb and jerk (1/2 at the reference)."""
+    return 1.0 / (1.0 + value / reference)

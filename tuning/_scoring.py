@@ -2,8 +2,9 @@
 
 Term by term the formulas of :func:`planner._kernels_foot.footprint_goodness`,
 :func:`planner._kernels_foot.trajectory_goodness` and
-:func:`planner._kernels_foot.weighted_mean` (see :mod:`planner._weights` for their
-meaning), reading the weights vector ``w = ScoringWeights.to_array()`` through the
+:func:`planner._kernels_foot.weighted_mean`: each goodness calls the same law as the kernel
+(:func:`planner._weights.falling_goodness`, ``rising_goodness``, ``rational_goodness``, one
+source for both), reading the weights vector ``w = ScoringWeights.to_array()`` through the
 same index constants. Raw inputs are the harvest's (:mod:`planner._harvest`):
 
 * footprint features (..., 5) in ``planner.FEATURES`` order;
@@ -47,6 +48,9 @@ from planner._weights import (
     W_PROXIMITY_REF,
     W_SLOPE_CRITICAL,
     W_STEP_CRITICAL,
+    falling_goodness,
+    rational_goodness,
+    rising_goodness,
 )
 
 
@@ -54,16 +58,16 @@ def _saturating(value, reference):
     """min(1, value / reference), = 1 for value = +inf, with finite gradients there."""
     finite = jnp.isfinite(value)
     safe = jnp.where(finite, value, 0.0)
-    return jnp.where(finite, jnp.minimum(1.0, safe / reference), 1.0)
+    return jnp.where(finite, jnp.minimum(1.0, rising_goodness(safe, reference)), 1.0)
 
 
 def footprint_goodness(features, w):
     """(..., 5) footprint goodnesses in [0, 1] (FOOTPRINT_TERMS order) of raw features (..., 5)."""
     f = jnp.asarray(features)
     return jnp.stack([
-        jnp.maximum(0.0, 1.0 - f[..., FEAT_DISTANCE] / w[W_DISTANCE_SCALE]),
-        jnp.maximum(0.0, 1.0 - f[..., FEAT_ROUGHNESS] / w[W_STEP_CRITICAL]),
-        jnp.maximum(0.0, 1.0 - f[..., FEAT_SLOPE] / w[W_SLOPE_CRITICAL]),
+        jnp.maximum(0.0, falling_goodness(f[..., FEAT_DISTANCE], w[W_DISTANCE_SCALE])),
+        jnp.maximum(0.0, falling_goodness(f[..., FEAT_ROUGHNESS], w[W_STEP_CRITICAL])),
+        jnp.maximum(0.0, falling_goodness(f[..., FEAT_SLOPE], w[W_SLOPE_CRITICAL])),
         _saturating(f[..., FEAT_LEG_GAP], w[W_LEG_SPACING_REF]),
         _saturating(f[..., FEAT_PROXIMITY], w[W_PROXIMITY_REF]),
     ], axis=-1)
@@ -75,11 +79,11 @@ def trajectory_goodness(raw, d_ref, w):
     r = jnp.asarray(raw)
     d_ref = jnp.asarray(d_ref)
     return jnp.stack([
-        d_ref / jnp.maximum(r[..., RAW_LENGTH], d_ref),
-        1.0 / (1.0 + r[..., RAW_CURVATURE] / w[W_CURVATURE_REF]),
+        rising_goodness(d_ref, jnp.maximum(r[..., RAW_LENGTH], d_ref)),
+        rational_goodness(r[..., RAW_CURVATURE], w[W_CURVATURE_REF]),
         _saturating(r[..., RAW_CLEARANCE], w[W_CLEARANCE_REF]),
-        1.0 / (1.0 + r[..., RAW_CLIMB] / w[W_CLIMB_REF]),
-        1.0 / (1.0 + r[..., RAW_JERK] / w[W_JERK_REF]),
+        rational_goodness(r[..., RAW_CLIMB], w[W_CLIMB_REF]),
+        rational_goodness(r[..., RAW_JERK], w[W_JERK_REF]),
     ], axis=-1)
 
 
