@@ -491,25 +491,23 @@ def _lane_exit(model: CrowdModel, state: CrowdState, direction: np.ndarray, boxe
     half_along = _half_extents_along(half, yaws[moving], u)
     half_across = _half_extents_along(half, yaws[moving], side_axis)
     room = model.rest_radius + model.controller.threat_margin
-    rel = state.pelvis[:, None, [0, 2]] - centres[moving][None, :, [0, 2]]  # (C, B, 2) box -> pelvis
-    along = (rel * u[None]).sum(-1)
-    across = (rel * side_axis[None]).sum(-1)
-    # The box and the character close in at the box's speed plus the character's own toward it.
-    walk = state.speed[:, None] * (np.cos(state.heading)[:, None] * u[None, :, 0]
-                                   + np.sin(state.heading)[:, None] * u[None, :, 1])  # (C, B) along u
-    closing = speed[None] + np.maximum(-walk, 0.0)
-    threat = ((np.abs(across) < half_across[None] + room) & (along > -(half_along[None] + room))
-              & (along - half_along[None] - room < closing * LANE_HORIZON))
+    # The box and the character close in at the box's speed plus the character's own toward it; the
+    # nearer side, and a character dead centre takes the side its way leans to (a way with no part
+    # across the lane: the side of -side_axis, a fixed convention so that the choice is deterministic).
+    from planner._kernels_lanes import lane_threats
+
+    n_boxes = moving.size
+    threat = np.empty((n, n_boxes), np.bool_)
+    side = np.empty((n, n_boxes))
+    each_exit = np.empty((n, n_boxes, 2))
+    exit_way = np.empty((n, 2))
+    xz = np.ascontiguousarray(state.pelvis[:, [0, 2]])
+    lane_threats(xz, state.speed, np.cos(state.heading), np.sin(state.heading), np.ascontiguousarray(direction),
+                 np.ascontiguousarray(centres[moving][:, [0, 2]]), np.ascontiguousarray(u), np.ascontiguousarray(side_axis),
+                 half_along, half_across, speed, room, LANE_HORIZON, threat, side, each_exit, exit_way)
     in_lane = threat.any(axis=1)
     if not in_lane.any():
         return direction, in_lane
-    # The nearer side; a character dead centre takes the side its way leans to (a way with no part
-    # across the lane: the side of -side_axis, a fixed convention so that the choice is deterministic).
-    way_side = (direction[:, None, :] * side_axis[None]).sum(-1)
-    side = np.where(np.abs(across) > 1e-6, np.sign(across), np.where(way_side > 0.0, 1.0, -1.0))
-    ahead = np.maximum((direction[:, None, :] * u[None]).sum(-1), 0.0)
-    each_exit = side[..., None] * side_axis[None] + 0.5 * ahead[..., None] * u[None]  # (C, B, 2)
-    exit_way = (each_exit * threat[..., None]).sum(axis=1)
     norm = np.hypot(exit_way[:, 0], exit_way[:, 1])
     turn = in_lane & (norm > 1e-9)
     direction = direction.copy()
@@ -525,7 +523,8 @@ def _lane_exit(model: CrowdModel, state: CrowdState, direction: np.ndarray, boxe
         candidates = np.concatenate([direction[several][:, None], each_exit[several] / np.maximum(
             np.hypot(each_exit[several, :, 0], each_exit[several, :, 1]), 1e-12)[..., None],
             np.broadcast_to(-side_axis[None], (several.size,) + side_axis.shape) * side[several][..., None]], axis=1)
-        contact = _time_to_contact(candidates, state.desired_speed[several], rel[several], velocity, u, side_axis,
+        rel = xz[several][:, None] - centres[moving][None, :, [0, 2]]  # (R, B, 2) box -> pelvis
+        contact = _time_to_contact(candidates, state.desired_speed[several], rel, velocity, u, side_axis,
                                    half_along + room, half_across + room, sub)
         # Ties keep the earlier candidate: the sum first, as with one box.
         best = np.argmax(contact, axis=1)

@@ -11,6 +11,7 @@ import math
 import numpy as np
 import pytest
 
+from conftest import fresh_seeds
 from planner._counters import FrameCounters
 from planner._crowd import DT, init_crowd, stage_steer, step
 from scenarios import load_creature, load_scenario
@@ -549,3 +550,46 @@ def test_an_escape_whose_orca_velocity_points_back_turns_to_the_lane_exits_side(
     else:
         assert np.sign(state.turn_wanted[0]) == side
         assert state.speed[0] == 0.0
+
+
+@pytest.mark.parametrize("seed", fresh_seeds([0, 1, 2], 3, salt=91))
+def test_the_lane_kernel_is_the_lane_rule_written_out_in_numpy(seed):
+    # planner._kernels_lanes.lane_threats against the rule written out here with whole arrays (as the
+    # steering computed it before the kernel): random characters and boxes, every output bit for bit.
+    from planner._kernels_lanes import lane_threats
+
+    rng = np.random.default_rng(seed)
+    n, b = int(rng.integers(1, 60)), int(rng.integers(1, 6))
+    pelvis = rng.uniform(-3.0, 3.0, (n, 2))
+    speed, heading = rng.uniform(0.0, 0.5, n) * (rng.random(n) > 0.2), rng.uniform(-np.pi, np.pi, n)
+    way = rng.normal(size=(n, 2))
+    way /= np.hypot(*way.T)[:, None]
+    way[0] = [0.0, 1.0]  # a way with no part across a lane along x (the dead-centre tie)
+    centres = rng.uniform(-3.0, 3.0, (b, 2))
+    velocity = rng.normal(size=(b, 2)) * 0.3
+    velocity[0] = [0.25, 0.0]
+    pelvis[0] = centres[0] + [1.0, 0.0]  # dead centre of box 0's lane, ahead of it
+    box_speed = np.hypot(*velocity.T)
+    u = velocity / box_speed[:, None]
+    side_axis = np.column_stack([-u[:, 1], u[:, 0]])
+    half_along, half_across = rng.uniform(0.1, 0.5, b), rng.uniform(0.1, 0.5, b)
+    room, horizon = 0.38, 3.0
+
+    rel = pelvis[:, None] - centres[None]
+    along, across = (rel * u[None]).sum(-1), (rel * side_axis[None]).sum(-1)
+    walk = speed[:, None] * (np.cos(heading)[:, None] * u[None, :, 0] + np.sin(heading)[:, None] * u[None, :, 1])
+    closing = box_speed[None] + np.maximum(-walk, 0.0)
+    threat = ((np.abs(across) < half_across[None] + room) & (along > -(half_along[None] + room))
+              & (along - half_along[None] - room < closing * horizon))
+    way_side = (way[:, None, :] * side_axis[None]).sum(-1)
+    side = np.where(np.abs(across) > 1e-6, np.sign(across), np.where(way_side > 0.0, 1.0, -1.0))
+    ahead = np.maximum((way[:, None, :] * u[None]).sum(-1), 0.0)
+    each_exit = side[..., None] * side_axis[None] + 0.5 * ahead[..., None] * u[None]
+    exit_way = (each_exit * threat[..., None]).sum(axis=1)
+
+    got = (np.empty((n, b), np.bool_), np.empty((n, b)), np.empty((n, b, 2)), np.empty((n, 2)))
+    lane_threats(pelvis, speed, np.cos(heading), np.sin(heading), way, centres, u, side_axis, half_along, half_across,
+                 box_speed, room, horizon, *got)
+    assert threat[0, 0] and side[0, 0] == 1.0, "the dead-centre case is in the draw (its way leans to +z)"
+    for name, mine, expected in zip(("threat", "side", "each_exit", "exit_way"), got, (threat, side, each_exit, exit_way)):
+        np.testing.assert_array_equal(mine, expected, err_msg=f"seed {seed}: {name}")
