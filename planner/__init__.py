@@ -14,7 +14,7 @@ from planner._batch import BatchResult, FootBatch, make_batch, plan_batch  # noq
 from planner._crowd import ControllerConfig, CrowdModel, CrowdState, init_crowd, planner_config_for, step  # noqa: E402
 from planner._gait import GaitManagerState, advance, init_gaits, set_destination, set_speed  # noqa: E402
 from planner._grid import GridFrame  # noqa: E402
-from planner._harvest import FEATURES, FootHarvest, Harvest, harvest_foot, harvest_situations  # noqa: E402
+from planner._harvest import FEATURES, FootHarvest, Harvest, harvest_foot, harvest_situations, task_mapper  # noqa: E402
 from planner._ik import IKResult, body_rotation, legs_of, rest_pose_angles, solve_legs  # noqa: E402
 from planner._lod import FULL_SEARCH, LOD_MODES, LodConfig  # noqa: E402
 from planner._maps import LocalMaps, WorldRaster  # noqa: E402
@@ -27,16 +27,32 @@ from planner._params import (  # noqa: E402
 )
 from planner._presets import PRESET_SCHEMA_VERSION, Preset, load_preset, preset_dict  # noqa: E402
 from planner._search import COUNTERS, RAW_METRICS, CoupleResult, FootQuery, plan_foot, wavefront_distances  # noqa: E402
-from planner._simulation import RECORDING_VERSION, Recorder, SimulationSummary, simulate  # noqa: E402
+from planner._simulation import RECORDING_VERSION, Recorder, SimulationSummary, arrived, realised_strides, simulate  # noqa: E402
 from planner._threads import single_threaded  # noqa: E402
-from planner._timing import GaitTiming, duty_factor, stride_frequency, stride_length  # noqa: E402
+from planner._timing import (  # noqa: E402
+    GRAVITY,
+    SWING_MAX,
+    SWING_MIN,
+    GaitTiming,
+    duty_factor,
+    duty_law,
+    froude_law,
+    hip_height,
+    stride_frequency,
+    stride_law,
+    stride_length,
+)
 from planner._weights import (  # noqa: E402
     FOOTPRINT_TERMS,
     SCORE_TERMS,
     TRAJECTORY_TERMS,
     WEIGHT_FIELDS,
     ScoringWeights,
+    falling_goodness,
+    rational_goodness,
+    rising_goodness,
 )
+from planner import layout  # noqa: E402  (the packed arrays' names and indices)
 
 __all__ = [
     "COUNTERS",
@@ -46,14 +62,18 @@ __all__ = [
     "FIRST_VALID",
     "FOOTPRINT_TERMS",
     "FULL_SEARCH",
+    "GRAVITY",
     "LOD_MODES",
     "PRESET_SCHEMA_VERSION",
     "RAW_METRICS",
     "RECORDING_VERSION",
     "SCORE_TERMS",
+    "SWING_MAX",
+    "SWING_MIN",
     "TRAJECTORY_TERMS",
     "WEIGHT_FIELDS",
     "advance",
+    "arrived",
     "BatchResult",
     "body_rotation",
     "ControllerConfig",
@@ -61,18 +81,23 @@ __all__ = [
     "CrowdModel",
     "CrowdState",
     "duty_factor",
+    "duty_law",
+    "falling_goodness",
     "FootBatch",
     "FootHarvest",
     "FootQuery",
+    "froude_law",
     "GaitManagerState",
     "GaitTiming",
     "GridFrame",
+    "Harvest",
     "harvest_foot",
     "harvest_situations",
-    "Harvest",
+    "hip_height",
     "IKResult",
     "init_crowd",
     "init_gaits",
+    "layout",
     "legs_of",
     "load_preset",
     "LocalMaps",
@@ -84,19 +109,24 @@ __all__ = [
     "PlannerConfig",
     "Preset",
     "preset_dict",
+    "rational_goodness",
+    "realised_strides",
     "Recorder",
     "rest_pose_angles",
+    "rising_goodness",
     "ScoringWeights",
     "SearchBudget",
     "set_destination",
-    "single_threaded",
     "set_speed",
     "simulate",
     "SimulationSummary",
+    "single_threaded",
     "solve_legs",
     "step",
     "stride_frequency",
+    "stride_law",
     "stride_length",
+    "task_mapper",
     "wavefront_distances",
     "WorldRaster",
 ]

@@ -20,7 +20,7 @@ def configure_numba_cache() -> Path:
     here = Path(__file__).resolve().parent
     digest = hashlib.sha256()
     # The kernels, and the modules whose constants (index constants) they compile in.
-    sources = [*here.glob("_kernels_*.py"), *(here / n for n in ("_grid.py", "_params.py", "_weights.py", "_timing.py"))]
+    sources = [*here.glob("_kernels_*.py"), *(here / n for n in ("_grid.py", "_params.py", "_weights.py", "_timing.py", "layout.py"))]
     for path in sorted(sources):
         digest.update(path.name.encode())
         digest.update(path.read_bytes())

@@ -24,7 +24,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planner._kernels_foot import N_FEATURES, N_RAW
 from planner._kernels_geometry import foot_offsets
 from planner._kernels_search import MODE_SEARCH, harvest_foot_kernel, plan_foot_kernel
 from planner._maps import LocalMaps
@@ -32,12 +31,8 @@ from planner._params import DEFAULT_BUDGET, PlannerConfig, SearchBudget
 from planner._search import FootQuery, checked_foot_offsets
 from planner._threads import single_threaded
 from planner._weights import N_FOOTPRINT_TERMS, N_TERMS, ScoringWeights
+from planner.layout import FEATURES, N_FEATURES, N_RAW  # FEATURES: the order of ``cand_features``
 
-FEATURES = ("distance_m", "roughness_m", "slope_rad", "leg_gap_m", "obstacle_distance_m")
-"""Raw footprint features, in the order of ``cand_features`` (FEAT_* of planner._kernels_foot)."""
-assert len(FEATURES) == N_FEATURES
-# Request kinds of the crowd (planner._crowd.stage_requests).
-KIND_NEW_SWING, KIND_FORCED_STEP, KIND_REPLAN = 1, 2, 3
 
 
 @dataclass(frozen=True)
@@ -97,7 +92,7 @@ class Harvest:
     frame: np.ndarray  # (F,)
     character: np.ndarray  # (F,)
     leg: np.ndarray  # (F,)
-    kind: np.ndarray  # (F,) KIND_*
+    kind: np.ndarray  # (F,) planner.layout.KIND_*
     leg_height: np.ndarray  # (F,) m, h of the Froude number (planner._timing.hip_height)
     speed: np.ndarray  # (F,) m/s, the character's speed when it planned
     forward: np.ndarray  # (F, 2) unit heading (x, z)

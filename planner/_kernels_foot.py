@@ -26,6 +26,29 @@ import numpy as np
 from planner._grid import cell_centre, cell_of
 from planner._kernels_geometry import segment_point_distance, segments_cross, supercover_visit
 from planner._kernels_wavefront import chamfer_distance
+# The raw trajectory metrics (RAW_*), footprint features (FEAT_*) and counters (CNT_*), in the order of the
+# results: planner.layout.
+from planner.layout import (  # noqa: F401  (re-exported: the kernels' callers read them from here too)
+    CNT_CANDIDATES,
+    CNT_COUPLES_2D,
+    CNT_COUPLES_3D,
+    CNT_EXPANDED,
+    CNT_SLICES,
+    CNT_WAVEFRONTS,
+    FEAT_DISTANCE,
+    FEAT_LEG_GAP,
+    FEAT_PROXIMITY,
+    FEAT_ROUGHNESS,
+    FEAT_SLOPE,
+    N_COUNTERS,
+    N_FEATURES,
+    N_RAW,
+    RAW_CLEARANCE,
+    RAW_CLIMB,
+    RAW_CURVATURE,
+    RAW_JERK,
+    RAW_LENGTH,
+)
 from planner._weights import (
     N_FOOTPRINT_TERMS,
     N_TERMS,
@@ -67,15 +90,6 @@ JERK_SAMPLES = 48
 U_LO = 0.05  # curvature and jerk are evaluated for u in [U_LO, U_HI] (singular at the ends)
 U_HI = 0.95
 
-# Raw trajectory metrics, in this order, in results.
-RAW_LENGTH, RAW_CURVATURE, RAW_CLEARANCE, RAW_CLIMB, RAW_JERK = range(5)
-N_RAW = 5
-# Raw footprint features, in this order (footprint_features; the harvest's rows; tuning/).
-FEAT_DISTANCE, FEAT_ROUGHNESS, FEAT_SLOPE, FEAT_LEG_GAP, FEAT_PROXIMITY = range(5)
-N_FEATURES = 5
-# Counters, in this order, in results.
-CNT_COUPLES_3D, CNT_COUPLES_2D, CNT_EXPANDED, CNT_WAVEFRONTS, CNT_CANDIDATES, CNT_SLICES = range(6)
-N_COUNTERS = 6
 
 
 @nb.njit(cache=True)

@@ -73,12 +73,14 @@ from planner._kernels_foot import (
 from planner._kernels_wavefront import wavefront
 from planner._params import C_CELL, C_MARGIN, C_OBST_MARGIN, C_POT_GAIN, C_POT_RANGE, C_RADIUS, C_SAMPLES, C_SLICE_EPS
 from planner._weights import N_FOOTPRINT_TERMS, N_TERMS
-
-MODE_SEARCH = 0
-MODE_PER_TARGET = 1
-MODE_BRUTE_FORCE = 2
-
-SCORE_COUPLE, SCORE_FOOTPRINT, SCORE_TRAJECTORY = range(3)
+from planner.layout import (  # noqa: F401  (the search modes and the scores' order: planner.layout)
+    MODE_BRUTE_FORCE,
+    MODE_PER_TARGET,
+    MODE_SEARCH,
+    SCORE_COUPLE,
+    SCORE_FOOTPRINT,
+    SCORE_TRAJECTORY,
+)
 
 
 @nb.njit(cache=True)

@@ -7,17 +7,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from planner._kernels_foot import N_COUNTERS, N_RAW
 from planner._kernels_geometry import foot_offsets
 from planner._kernels_search import MODE_BRUTE_FORCE, MODE_PER_TARGET, MODE_SEARCH, plan_foot_kernel
 from planner._kernels_wavefront import wavefront
 from planner._maps import LocalMaps
 from planner._params import DEFAULT_BUDGET, PlannerConfig, SearchBudget
 from planner._weights import SCORE_TERMS, ScoringWeights
+from planner.layout import COUNTERS, N_COUNTERS, N_RAW, RAW_METRICS
 
-RAW_METRICS = ("length_m", "curvature_energy", "clearance_m", "climb_m", "jerk")
-COUNTERS = ("couples_evaluated", "couples_2d", "cells_expanded", "wavefronts", "candidates", "slices")
-assert len(RAW_METRICS) == N_RAW and len(COUNTERS) == N_COUNTERS
 MODES = {"search": MODE_SEARCH, "per_target": MODE_PER_TARGET, "brute_force": MODE_BRUTE_FORCE}
 
 

@@ -59,8 +59,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planner._harvest import task_mapper
-from planner._kernels_foot import RAW_CURVATURE
+from planner import task_mapper
+from planner.layout import RAW_CURVATURE
 
 EVENT_FRAMES = 300
 SPAWN_FRACTIONS = (0.15, 0.3, 0.45)
@@ -170,11 +170,8 @@ def replay_command(task: dict, preset: str = "PRESET.json") -> str:
 def run_event_task(task: dict) -> dict:
     """One run of :func:`event_tasks`: the simulation's summary and the plan metrics (picklable)."""
     from footfall._runs import resolve_gait
-    from planner import single_threaded
-    from planner._crowd import init_crowd
-    from planner._simulation import arrived, simulate
-    from planner._timing import GaitTiming, hip_height
-    from planner._weights import W_SLOPE_CRITICAL, W_STEP_CRITICAL, ScoringWeights
+    from planner import GaitTiming, ScoringWeights, arrived, hip_height, init_crowd, simulate, single_threaded
+    from planner.layout import W_SLOPE_CRITICAL, W_STEP_CRITICAL
     from scenarios import load_creature, load_scenario
 
     weights = ScoringWeights.from_array(task["weights"])

@@ -77,7 +77,8 @@ import jax.numpy as jnp
 import numpy as np
 import optimistix as optx
 
-from planner._timing import GRAVITY, TIMING_FIELDS
+from planner import GRAVITY
+from planner.layout import TIMING_FIELDS
 from tuning._proxies import Situations, duty_factor, expected_metrics, stride_frequency
 
 FITTED_TIMING = ("stride_coefficient", "stride_exponent", "duty_at_rest", "duty_slope")

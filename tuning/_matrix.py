@@ -166,8 +166,7 @@ def run_matrix(presets_dir: str | Path, names=None, runs: int = RUNS, terrains=N
                progress=None) -> dict:
     """Every preset of ``names`` (default: :data:`PRESETS`) found in ``presets_dir`` (``NAME.json``)
     against the defaults on ``terrains`` (default: :data:`TERRAINS`); the matrix (JSON-ready)."""
-    from planner._presets import load_preset
-    from planner._weights import ScoringWeights
+    from planner import ScoringWeights, load_preset
     from tuning._targets import load_tune_targets
 
     names = tuple(names or PRESETS)

@@ -67,12 +67,20 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from planner._kernels_foot import FEAT_DISTANCE, FEAT_PROXIMITY, FEAT_ROUGHNESS, FEAT_SLOPE, N_FEATURES, N_RAW, RAW_CLEARANCE, RAW_CLIMB
-from planner._kernels_foot import RAW_CURVATURE, RAW_JERK, RAW_LENGTH
-from planner._timing import (
-    GRAVITY,
-    SWING_MAX,
-    SWING_MIN,
+from planner import GRAVITY, SWING_MAX, SWING_MIN, duty_law, stride_law
+from planner.layout import (
+    FEAT_DISTANCE,
+    FEAT_PROXIMITY,
+    FEAT_ROUGHNESS,
+    FEAT_SLOPE,
+    KIND_REPLAN,
+    N_FEATURES,
+    N_RAW,
+    RAW_CLEARANCE,
+    RAW_CLIMB,
+    RAW_CURVATURE,
+    RAW_JERK,
+    RAW_LENGTH,
     T_DUTY_AT_REST,
     T_DUTY_MAX,
     T_DUTY_MIN,
@@ -80,15 +88,12 @@ from planner._timing import (
     T_MIN_FREQUENCY,
     T_STRIDE_COEFFICIENT,
     T_STRIDE_EXPONENT,
-    duty_law,
-    stride_law,
 )
 from tuning._config import enable_x64
 from tuning._scoring import couple_score
 
 LEAST_FREQUENCY_HZ = 1e-3
 """The crowd divides by max(f, 1e-3) (planner._crowd.stage_plan)."""
-KIND_REPLAN = 3
 
 PROXY_METRICS = ("step_length_m", "forward_offset_m", "offset_m", "touchdown_slope_rad", "touchdown_roughness_m",
                  "detour_ratio", "touchdown_clearance_m", "length_m", "curvature_energy", "clearance_m", "climb_m", "jerk", "couple_score")

@@ -24,21 +24,20 @@ from __future__ import annotations
 
 import jax.numpy as jnp
 
-from planner._kernels_foot import (
+from planner import falling_goodness, rational_goodness, rising_goodness
+from planner.layout import (
     FEAT_DISTANCE,
     FEAT_LEG_GAP,
     FEAT_PROXIMITY,
     FEAT_ROUGHNESS,
     FEAT_SLOPE,
+    N_FOOTPRINT_TERMS,
+    N_TERMS,
     RAW_CLEARANCE,
     RAW_CLIMB,
     RAW_CURVATURE,
     RAW_JERK,
     RAW_LENGTH,
-)
-from planner._weights import (
-    N_FOOTPRINT_TERMS,
-    N_TERMS,
     W_CLEARANCE_REF,
     W_CLIMB_REF,
     W_CURVATURE_REF,
@@ -48,9 +47,6 @@ from planner._weights import (
     W_PROXIMITY_REF,
     W_SLOPE_CRITICAL,
     W_STEP_CRITICAL,
-    falling_goodness,
-    rational_goodness,
-    rising_goodness,
 )
 
 

@@ -131,7 +131,7 @@ class CreatureTargets:
         then commands the target law, and its per-stride error is measured against it."""
         import dataclasses
 
-        from planner._timing import GaitTiming
+        from planner import GaitTiming
 
         c, e = self.stride_law
         return dataclasses.replace(base or GaitTiming(), stride_coefficient=c, stride_exponent=e)
@@ -200,7 +200,7 @@ def load_targets(path: str | Path = TARGETS_FILE, creatures=None) -> dict[str, C
 
 def _whole_targets(data: dict, file: str, creatures) -> dict[str, CreatureTargets]:
     """:func:`load_targets` of a whole targets file's parsed ``data`` (``file`` names it in errors)."""
-    from planner._timing import hip_height
+    from planner import hip_height
     from scenarios import builtin_creature_names, load_creature
 
     for key in data:

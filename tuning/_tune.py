@@ -164,7 +164,8 @@ class TuneConfig:
 
     def start(self):
         """The ``GaitTiming`` the search starts from: the defaults with ``start_timing`` applied."""
-        from planner._timing import TIMING_FIELDS, GaitTiming
+        from planner import GaitTiming
+        from planner.layout import TIMING_FIELDS
 
         try:
             pairs = dict((str(name), float(value)) for name, value in self.start_timing)
@@ -253,22 +254,20 @@ def _params(weights, timing) -> dict:
 
 def _start_params(config: TuneConfig) -> dict:
     """The default weights and ``config.start()``'s timing: where the search begins."""
-    from planner._weights import ScoringWeights
+    from planner import ScoringWeights
 
     return _params(ScoringWeights().to_array(), config.start().to_array())
 
 
 def _default_params() -> dict:
     """The runtime's defaults (the start when ``start_timing`` is empty)."""
-    from planner._timing import GaitTiming
-    from planner._weights import ScoringWeights
+    from planner import GaitTiming, ScoringWeights
 
     return _params(ScoringWeights().to_array(), GaitTiming().to_array())
 
 
 def _objects(params: dict):
-    from planner._timing import GaitTiming
-    from planner._weights import ScoringWeights
+    from planner import GaitTiming, ScoringWeights
 
     return (ScoringWeights.from_array(np.asarray(params["weights"], dtype=np.float64)),
             GaitTiming.from_array(np.asarray(params["timing"], dtype=np.float64)))
@@ -345,7 +344,7 @@ def _bucket(x: int, step: int) -> int:
 def _by_froude(exact: dict, leg_height: float, value) -> list[tuple[float, float]]:
     """(mean realised Fr, mean value(run)) per Froude number of the sweep, sorted; runs where
     ``value`` is None or the pelvis did not move are left out."""
-    from planner._timing import GRAVITY
+    from planner import GRAVITY
 
     groups: dict[float, list[tuple[float, float]]] = {}
     for run in exact["runs"]:
@@ -393,7 +392,7 @@ def speed_variant(name: str, speed: float) -> str:
 
 
 def _harvest(config: TuneConfig, params: dict, seed: int, map_tasks=None):
-    from planner._harvest import harvest_situations
+    from planner import harvest_situations
 
     weights, timing = _objects(params)
     speeds = speeds_for(config.exact_setup())
@@ -405,7 +404,7 @@ def _harvest(config: TuneConfig, params: dict, seed: int, map_tasks=None):
 
 def _fit_round(config: TuneConfig, params: dict, exact_current: dict, round_index: int, targets, map_tasks=None):
     """Harvest under ``params``, fit; returns (new params, fit record)."""
-    from planner._timing import GRAVITY
+    from planner import GRAVITY
     from tuning._fit import fit, initial_params, loss, make_problem
     from tuning._proxies import situations_from_harvest
 
@@ -569,7 +568,7 @@ def tune(config: TuneConfig, out: str | Path, resume: bool = False, progress=Non
 
 
 def _tune(config: TuneConfig, out, resume, progress, stop_after, write, evaluate, map_tasks, t0) -> TuneResult:
-    from planner._presets import preset_dict
+    from planner import preset_dict
     from scenarios import default_gait_name, load_creature
     from tuning._config import enable_x64
     from tuning._targets import TARGETS_FILE, load_targets

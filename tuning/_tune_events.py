@@ -155,7 +155,7 @@ def check_scenarios(names) -> tuple[str, ...]:
 
 
 def _start(targets) -> dict:
-    from planner._weights import ScoringWeights
+    from planner import ScoringWeights
 
     return {"weights": _floats(ScoringWeights().to_array()), "timing": _floats(targets.timing().to_array())}
 
@@ -174,7 +174,7 @@ def style_start(params: dict, targets) -> dict:
     both 0.9 %. The fit moves the weights on from there (its gradient for the proximity weight stays
     small: one term of ten, for the few footprints near a box); every candidate is judged against the
     defaults' runs, and the preset's change is measured from the defaults."""
-    from planner._weights import W_PROXIMITY_REF
+    from planner.layout import W_PROXIMITY_REF
 
     bound = targets.style.get("min_clearance_body_heights") if targets.style else None
     if bound is None:
@@ -185,7 +185,7 @@ def style_start(params: dict, targets) -> dict:
 
 
 def _fit_round(config: EventTuneConfig, params: dict, round_index: int, targets, map_tasks):
-    from planner._harvest import harvest_situations
+    from planner import harvest_situations
     from tuning._fit import fit, initial_params, loss, make_problem
     from tuning._proxies import situations_from_harvest
 
@@ -285,7 +285,7 @@ def tune_events(config: EventTuneConfig, out, resume: bool = False, progress=Non
 
 def _run(config, out, resume, progress, stop_after, write, map_tasks, t0, spearman_candidates,
          evaluate=True) -> TuneResult:
-    from planner._presets import preset_dict
+    from planner import preset_dict
     from scenarios import default_gait_name, load_creature
     from tuning._config import enable_x64
     from tuning._targets import load_tune_targets
