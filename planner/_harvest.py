@@ -153,8 +153,8 @@ def _harvest_batch(batch, weights, config, out, cs, ls, kinds, state, model, met
         # The exhaustive search (no couple limit, no early stop) on the same foot and slices.
         best = plan_foot_kernel(*args, -1, slice_size, False, MODE_SEARCH)
         chosen = (-1, -1)
-        if best[0]:
-            chosen = _row_of(foot.cand_cells, foot.levels.size, best[1], int(best[3]))
+        if best.valid:
+            chosen = _row_of(foot.cand_cells, foot.levels.size, best.target_rc, int(best.slice_index))
         crowd = (-1, -1)
         if out.valid[i]:
             # The target is a candidate's continuous footprint, computed by the same kernel: equal bit for bit.
@@ -169,7 +169,8 @@ def _harvest_batch(batch, weights, config, out, cs, ls, kinds, state, model, met
             relative_swing=float(lengths[c, leg] / np.mean(lengths[c])), source=batch.sources[i].copy(),
             preferred=batch.preferred[i].copy(), cell_size=config.cell_size, origin=batch.origins[ch].copy(), foot=foot,
             chosen=chosen,
-            chosen_scores=best[5].copy(), chosen_terms=best[6].copy(), chosen_raw=best[7].copy(), crowd_choice=crowd))
+            chosen_scores=best.scores.copy(), chosen_terms=best.terms.copy(), chosen_raw=best.raw.copy(),
+            crowd_choice=crowd))
 
 
 def _pack(rows: list[dict], creatures, scenarios, weights: np.ndarray, timing: np.ndarray) -> Harvest:

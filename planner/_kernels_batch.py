@@ -24,15 +24,15 @@ def plan_one_into(i, elevation, ground, forbidden, origins, foot_char, foot_shap
                            sources[i], preferred[i], hips[i], reach_xz[i], step_height[i],
                            legs[legs_start[i]:legs_start[i + 1]], block_radius[i], w, cfg, couples_after_first[i],
                            slice_size[i], early[i], mode)
-    out_valid[i] = res[0]
-    out_target[i, :] = res[2]
-    out_slice[i] = res[3]
-    out_level[i] = res[4]
-    out_scores[i, :] = res[5]
-    out_terms[i, :] = res[6]
-    out_raw[i, :] = res[7]
-    out_counters[i, :] = res[8]
-    out_traj[i, :, :] = res[9]
+    out_valid[i] = res.valid
+    out_target[i, :] = res.target_xyz
+    out_slice[i] = res.slice_index
+    out_level[i] = res.slice_level
+    out_scores[i, :] = res.scores
+    out_terms[i, :] = res.terms
+    out_raw[i, :] = res.raw
+    out_counters[i, :] = res.counters
+    out_traj[i, :, :] = res.trajectory
 
 
 @nb.njit(cache=True)

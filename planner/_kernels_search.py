@@ -38,6 +38,7 @@ Harvest (:func:`harvest_foot_kernel`, for tuning/)
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 
 import numba as nb
 import numpy as np
@@ -81,6 +82,13 @@ from planner.layout import (  # noqa: F401  (the search modes and the scores' or
     SCORE_FOOTPRINT,
     SCORE_TRAJECTORY,
 )
+
+
+CoupleOut = namedtuple("CoupleOut", ["valid", "target_rc", "target_xyz", "slice_index", "slice_level", "scores",
+                                     "terms", "raw", "counters", "trajectory", "candidate_rc", "candidate_scores"])
+"""What :func:`plan_foot_kernel` returns, by name: valid, the target's cell (2,) and point (3,), the slice
+and its level (m), the scores (3, ``planner.layout.SCORES`` order), the ten goodnesses, the raw metrics (5),
+the counters (6), the trajectory (K, 3), and the candidates' cells (n, 2) and footprint scores (n,)."""
 
 
 @nb.njit(cache=True)
@@ -144,12 +152,7 @@ def directness_references(cand_xz, source_x, source_z, cell):
 def plan_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, source, preferred, hip, reach_xz,
                      step_height, other_legs, feet_block_radius, w, cfg, couples_after_first, slice_size,
                      paper_early_stop, mode):
-    """Plan one foot. See the module docstring; returns a tuple of result arrays:
-
-    (valid, target_rc (2,), target_xyz (3,), slice_index, slice_level, scores (3,),
-     terms (10,), raw (5,), counters (6,), trajectory (K, 3), candidate_rc (n, 2),
-     candidate_scores (n,))
-    """
+    """Plan one foot. See the module docstring; returns a :data:`CoupleOut`."""
     cell = cfg[C_CELL]
     eps = cfg[C_SLICE_EPS]
     k_out = int(cfg[C_SAMPLES])
@@ -311,8 +314,8 @@ def plan_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, 
         target_xyz[1] = source_y
         target_xyz[2] = source_z
         level = np.nan
-    return (valid, target_rc, target_xyz, best_s, level, scores, best_terms, best_raw, counters, trajectory, cand_rc,
-            cand_scores)
+    return CoupleOut(valid, target_rc, target_xyz, best_s, level, scores, best_terms, best_raw, counters, trajectory,
+                     cand_rc, cand_scores)
 
 
 @nb.njit(cache=True)

@@ -13,7 +13,7 @@ from planner._kernels_wavefront import wavefront
 from planner._maps import LocalMaps
 from planner._params import DEFAULT_BUDGET, PlannerConfig, SearchBudget
 from planner._weights import SCORE_TERMS, ScoringWeights
-from planner.layout import COUNTERS, N_COUNTERS, N_RAW, RAW_METRICS
+from planner.layout import COUNTERS, N_COUNTERS, N_RAW, RAW_METRICS, SCORE_COUPLE, SCORE_FOOTPRINT, SCORE_TRAJECTORY
 
 MODES = {"search": MODE_SEARCH, "per_target": MODE_PER_TARGET, "brute_force": MODE_BRUTE_FORCE}
 
@@ -122,14 +122,14 @@ def plan_foot(maps: LocalMaps, query: FootQuery, weights: ScoringWeights | None 
         query.source, query.preferred, query.hip, float(query.reach_xz), float(query.step_height),
         query.other_legs, query.feet_block_radius, weights.to_array(), config.to_array(),
         couples_after_first, slice_size, early, MODES[mode])
-    valid, target_rc, target, s_idx, level, scores, terms, raw, counters, traj, cand_rc, cand_scores = out
     return CoupleResult(
-        valid=bool(valid), target_cell=(int(target_rc[0]), int(target_rc[1])), target=target,
-        slice_index=int(s_idx), slice_level_m=float(level), couple_score=float(scores[0]),
-        footprint_score=float(scores[1]), trajectory_score=float(scores[2]),
-        breakdown=dict(zip(SCORE_TERMS, map(float, terms))), metrics=dict(zip(RAW_METRICS, map(float, raw))),
-        counters=dict(zip(COUNTERS, map(int, counters))), trajectory=traj, candidate_cells=cand_rc,
-        candidate_scores=cand_scores)
+        valid=bool(out.valid), target_cell=(int(out.target_rc[0]), int(out.target_rc[1])), target=out.target_xyz,
+        slice_index=int(out.slice_index), slice_level_m=float(out.slice_level),
+        couple_score=float(out.scores[SCORE_COUPLE]), footprint_score=float(out.scores[SCORE_FOOTPRINT]),
+        trajectory_score=float(out.scores[SCORE_TRAJECTORY]),
+        breakdown=dict(zip(SCORE_TERMS, map(float, out.terms))), metrics=dict(zip(RAW_METRICS, map(float, out.raw))),
+        counters=dict(zip(COUNTERS, map(int, out.counters))), trajectory=out.trajectory,
+        candidate_cells=out.candidate_rc, candidate_scores=out.candidate_scores)
 
 
 def wavefront_distances(passable, source: tuple[int, int], cell_size: float = 1.0, cost_factor=None,
