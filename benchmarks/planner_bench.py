@@ -18,7 +18,7 @@ import time
 import numpy as np
 
 from planner import DEFAULT_BUDGET, EXHAUSTIVE, FIRST_VALID, PlannerConfig, ScoringWeights, make_batch
-from planner._kernels_batch import plan_feet_serial
+from planner._kernels_batch import FootRequests, FootResults, plan_feet_serial
 from planner._kernels_foot import footprint_candidates, prepare_foot, slice_maps, swing_reach
 from planner._kernels_geometry import foot_offsets
 from planner._kernels_wavefront import per_target_wavefronts, wavefront
@@ -45,17 +45,20 @@ def _per_foot_us(batch, weights, config, repeats: int) -> np.ndarray:
     cfg = config.to_array()
     k = config.trajectory_samples
     times = np.empty(batch.n_feet)
-    outs = (np.zeros(1, np.bool_), np.zeros((1, 3)), np.zeros(1, np.int64), np.zeros(1), np.zeros((1, 3)),
-            np.zeros((1, 10)), np.zeros((1, 5)), np.zeros((1, 6), np.int64), np.zeros((1, k, 3)))
+    outs = FootResults(np.zeros(1, np.bool_), np.zeros((1, 3)), np.zeros(1, np.int64), np.zeros(1), np.zeros((1, 3)),
+                       np.zeros((1, 10)), np.zeros((1, 5)), np.zeros((1, 6), np.int64), np.zeros((1, k, 3)))
     for i in range(batch.n_feet):
         ls, le = batch.legs_start[i], batch.legs_start[i + 1]
         ch = batch.foot_char[i]
-        args = (batch.elevation[ch:ch + 1], batch.ground[ch:ch + 1], batch.forbidden[ch:ch + 1],
-                batch.origins[ch:ch + 1], np.zeros(1, np.int64), batch.foot_shape[i:i + 1], batch.sources[i:i + 1],
-                batch.preferred[i:i + 1], batch.hips[i:i + 1], batch.reach_xz[i:i + 1], batch.step_height[i:i + 1],
-                np.ascontiguousarray(batch.legs[ls:le]), np.array([0, le - ls], np.int64), batch.block_radius[i:i + 1],
-                w, cfg, batch.couples_after_first[i:i + 1], batch.slice_size[i:i + 1], batch.early[i:i + 1],
-                MODES["search"]) + outs
+        request = FootRequests(
+            elevation=batch.elevation[ch:ch + 1], ground=batch.ground[ch:ch + 1], forbidden=batch.forbidden[ch:ch + 1],
+            origins=batch.origins[ch:ch + 1], foot_char=np.zeros(1, np.int64), foot_shape=batch.foot_shape[i:i + 1],
+            sources=batch.sources[i:i + 1], preferred=batch.preferred[i:i + 1], hips=batch.hips[i:i + 1],
+            reach_xz=batch.reach_xz[i:i + 1], step_height=batch.step_height[i:i + 1],
+            legs=np.ascontiguousarray(batch.legs[ls:le]), legs_start=np.array([0, le - ls], np.int64),
+            block_radius=batch.block_radius[i:i + 1], couples_after_first=batch.couples_after_first[i:i + 1],
+            slice_size=batch.slice_size[i:i + 1], early=batch.early[i:i + 1])
+        args = (request, w, cfg, MODES["search"], outs)
         times[i] = _time_best(lambda: plan_feet_serial(*args), repeats)
     return times * 1e6
 

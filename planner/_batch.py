@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planner._kernels_batch import plan_feet_parallel, plan_feet_serial
+from planner._kernels_batch import FootRequests, FootResults, plan_feet_parallel, plan_feet_serial
 from planner._kernels_foot import N_COUNTERS, N_RAW
 from planner._maps import LocalMaps
 from planner._params import DEFAULT_BUDGET, PlannerConfig, SearchBudget
@@ -107,9 +107,15 @@ def plan_batch(batch: FootBatch, weights: ScoringWeights | None = None, config: 
         slice_level=np.zeros(n), scores=np.zeros((n, 3)), terms=np.zeros((n, N_TERMS)), raw=np.zeros((n, N_RAW)),
         counters=np.zeros((n, N_COUNTERS), dtype=np.int64), trajectory=np.zeros((n, k, 3)))
     kernel = plan_feet_parallel if parallel else plan_feet_serial
-    kernel(batch.elevation, batch.ground, batch.forbidden, batch.origins, batch.foot_char, batch.foot_shape,
-                     batch.sources, batch.preferred, batch.hips, batch.reach_xz, batch.step_height, batch.legs,
-                     batch.legs_start, batch.block_radius, weights.to_array(), config.to_array(),
-                     batch.couples_after_first, batch.slice_size, batch.early, MODES[mode], out.valid, out.target,
-                     out.slice_index, out.slice_level, out.scores, out.terms, out.raw, out.counters, out.trajectory)
+    kernel(kernel_requests(batch), weights.to_array(), config.to_array(), MODES[mode], kernel_results(out))
     return out
+
+
+def kernel_requests(batch: FootBatch) -> FootRequests:
+    """The batch's arrays as the planning kernel reads them (the same arrays, by name)."""
+    return FootRequests(*(getattr(batch, name) for name in FootRequests._fields))
+
+
+def kernel_results(result: BatchResult) -> FootResults:
+    """The result's arrays as the planning kernel writes them (the same arrays, by name)."""
+    return FootResults(*(getattr(result, name) for name in FootResults._fields))
