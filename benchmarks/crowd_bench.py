@@ -90,7 +90,7 @@ def run(sizes=(100, 1000), frames: int = 60, warmup: int = 30, seed: int = 0, sc
         for k in range(frames):
             for j in np.roll(np.arange(len(MODES)), k):
                 mode = MODES[j]
-                timings = step(*crowds[mode])
+                timings = step(*crowds[mode]).timings
                 frame_ms[mode][k] = 1e3 * sum(timings.values())
                 for s in stage_ms[mode]:
                     stage_ms[mode][s][k] = 1e3 * timings[s]

@@ -11,7 +11,16 @@ _configure_numba_cache()
 _configure_worker_wait()
 
 from planner._batch import BatchResult, FootBatch, make_batch, plan_batch  # noqa: E402
-from planner._crowd import ControllerConfig, CrowdModel, CrowdState, init_crowd, planner_config_for, step  # noqa: E402
+from planner._crowd import (  # noqa: E402
+    ControllerConfig,
+    CrowdModel,
+    CrowdState,
+    FramePlans,
+    StepRecord,
+    init_crowd,
+    planner_config_for,
+    step,
+)
 from planner._gait import GaitManagerState, advance, init_gaits, set_destination, set_speed  # noqa: E402
 from planner._grid import GridFrame  # noqa: E402
 from planner._harvest import FEATURES, FootHarvest, Harvest, harvest_foot, harvest_situations, task_mapper  # noqa: E402
@@ -86,6 +95,7 @@ __all__ = [
     "FootBatch",
     "FootHarvest",
     "FootQuery",
+    "FramePlans",
     "froude_law",
     "GaitManagerState",
     "GaitTiming",
@@ -123,6 +133,7 @@ __all__ = [
     "single_threaded",
     "solve_legs",
     "step",
+    "StepRecord",
     "stride_frequency",
     "stride_law",
     "stride_length",

@@ -252,11 +252,6 @@ class CrowdState:
     blocks_escape: np.ndarray  # (C, L) bool: a stance foot that stops an escaping character's turn
     crossed: np.ndarray  # (C, L, L) bool: pairs of stance legs drawn crossed at the end of the last frame
     counters: dict = field(default_factory=dict)
-    last_plans: object = None  # (chars, legs, kinds, BatchResult) of the last frame, for recordings
-    last_batch: object = None  # the FootBatch planned in the last frame (what the tuning harvest re-scores)
-    # [(FootBatch, PlannerConfig, request rows, characters)] of the last frame, one per planning call: rows
-    # index last_plans' requests, the batch's foot_char indexes characters (LOD off: one call, last_batch's).
-    last_groups: list = field(default_factory=list)
     lod_level: np.ndarray | None = None  # (C,) int8: each character's level of detail (planner._lod, LEVEL_*)
     near_moving_box: np.ndarray | None = None  # (C,) bool: a moving box is near: it plans as a near character
 
@@ -1162,7 +1157,7 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     """Plan every request, one kernel call per planning group (``groups`` and their ``maps``,
     :func:`map_groups`, :func:`stage_maps`; a far group's fallback is one more); apply the results.
     Returns (the batch of the one near group, or None, the results of every request, the requests'
-    characters, legs)."""
+    characters, legs, every planning call as :class:`FramePlans` ``calls`` holds them)."""
     cs, ls = np.nonzero(kinds)
     f = cs.size
     n_legs = model.n_legs
@@ -1257,8 +1252,8 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
         couples_after_first=couples[cs], slice_size=slices[cs],
         # the paper's early termination (§5.2) always, unless a fixed budget says otherwise
         early=np.full(f, model.fixed_budget is None or model.fixed_budget.paper_early_stop, np.bool_))
-    out, state.last_groups = _plan_groups(model, state, request, cs, maps, groups, boxes)
-    batch = state.last_groups[0][0] if len(state.last_groups) == 1 and not groups[0][1] else None
+    out, calls = _plan_groups(model, state, request, cs, maps, groups, boxes)
+    batch = calls[0][0] if len(calls) == 1 and not groups[0][1] else None
     # Feet of different characters planned in the same frame do not see each other's targets: of two
     # that would land within a foot's room of each other, the later one (in plan order) waits a frame
     # and plans again, seeing the other's target.
@@ -1294,7 +1289,7 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     state.counters["replans"] += int((kinds[cs, ls] == 3).sum())
     state.counters["cells_expanded"] += int(out.counters[:, 2].sum())
     state.counters["couples_evaluated"] += int(out.counters[:, 0].sum())
-    return batch, out, cs, ls
+    return batch, out, cs, ls, calls
 
 
 TUCK_REACH = 0.25
@@ -1916,8 +1911,33 @@ def _spawned_feet_apart(fx, fz, room: float, rounds: int = 4):
 
 
 # ----------------------------------------------------------------------------- the frame
-def step(model: CrowdModel, state: CrowdState) -> dict[str, float]:
-    """Advance the crowd by one time step; returns the seconds spent per stage."""
+@dataclass(frozen=True)
+class FramePlans:
+    """The feet a frame planned: request i is leg ``legs[i]`` of character ``chars[i]``, of kind
+    ``kinds[i]`` (``planner.layout.KIND_*``), planned as ``result`` row i. ``batch``: the one
+    planning call's requests when there was one on the paper's maps (what the tuning harvest
+    re-scores; None when LOD split the frame); ``calls``: every planning call,
+    ``(FootBatch, PlannerConfig, request rows, characters)``, rows indexing the requests."""
+
+    chars: np.ndarray
+    legs: np.ndarray
+    kinds: np.ndarray
+    result: object
+    batch: object
+    calls: tuple
+
+
+@dataclass(frozen=True)
+class StepRecord:
+    """What :func:`step` did: the seconds each stage took (``timings``, :data:`STAGES` order) and the
+    feet it planned (``plans``; None in a frame that planned none)."""
+
+    timings: dict
+    plans: FramePlans | None
+
+
+def step(model: CrowdModel, state: CrowdState) -> StepRecord:
+    """Advance the crowd by one time step; returns what the step did (:class:`StepRecord`)."""
     timings = {}
     clock = time.perf_counter
     state.t += model.dt
@@ -1943,14 +1963,11 @@ def step(model: CrowdModel, state: CrowdState) -> dict[str, float]:
         planning = _planning_boxes(model, state, boxes)
         maps = [stage_maps(model, state, group, planning, model.far_first if far else None) for group, far in groups]
         t5 = clock()
-        batch, out, cs, ls = stage_plan(model, state, kinds, frequency, budgets, maps, groups, hips, planning)
-        state.last_plans = (cs, ls, kinds[cs, ls], out)
-        state.last_batch = batch
+        batch, out, cs, ls, calls = stage_plan(model, state, kinds, frequency, budgets, maps, groups, hips, planning)
+        plans = FramePlans(cs, ls, kinds[cs, ls], out, batch, tuple(calls))
     else:
         t5 = clock()
-        state.last_plans = None
-        state.last_batch = None
-        state.last_groups = []
+        plans = None
     t6 = clock()
     stage_pelvis(model, state)
     t7 = clock()
@@ -1960,4 +1977,4 @@ def step(model: CrowdModel, state: CrowdState) -> dict[str, float]:
     for name, (a, b) in zip(STAGES, ((t0, t1), (t1, t2), (t2, t3), (t3, t4), (t4, t5), (t5, t6), (t6, t7),
                                       (t7, t8))):
         timings[name] = b - a
-    return timings
+    return StepRecord(timings, plans)

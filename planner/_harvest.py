@@ -321,12 +321,11 @@ def harvest_chunk(task: dict) -> dict:
         rows: list[dict] = []
         frame_ends: list[int] = []
         for _ in range(task["frames"]):
-            step(model, state)
-            if state.last_plans is None:
+            plans = step(model, state).plans
+            if plans is None:
                 continue
-            cs, ls, kinds, out = state.last_plans
-            _harvest_batch(state.last_batch, model.weights, model.config, out, cs, ls, kinds, state, model, meta,
-                           rows)
+            _harvest_batch(plans.batch, model.weights, model.config, plans.result, plans.chars, plans.legs, plans.kinds,
+                           state, model, meta, rows)
             frame_ends.append(len(rows))
             # The global count is at least this chunk's, so the global cap never cuts later than here.
             if cap is not None and len(rows) >= cap:

@@ -107,7 +107,8 @@ class Recorder:
             self.arrays["lod_level"] = np.zeros((frames, c), np.int8)
         self.events: list[np.ndarray] = []
 
-    def capture(self, k: int, state: CrowdState, timings: dict) -> None:
+    def capture(self, k: int, state: CrowdState, record) -> None:
+        """Frame ``k``: the state after it and what its step did (``record``, planner._crowd.StepRecord)."""
         a = self.arrays
         a["pelvis"][k] = state.pelvis
         a["orientation"][k] = np.stack([state.heading, state.pitch, state.roll], axis=1)
@@ -120,11 +121,12 @@ class Recorder:
         a["speed"][k] = state.speed
         if "lod_level" in a:
             a["lod_level"][k] = state.lod_level
-        a["stage_seconds"][k] = [timings[s] for s in STAGES]
-        if state.last_plans is not None:
-            cs, ls, kinds, out = state.last_plans
-            ev = np.column_stack([np.full(cs.size, k), cs, ls, kinds, out.valid, out.target, out.scores, out.terms,
-                                  out.counters, out.slice_level])
+        a["stage_seconds"][k] = [record.timings[s] for s in STAGES]
+        plans = record.plans
+        if plans is not None:
+            out = plans.result
+            ev = np.column_stack([np.full(plans.chars.size, k), plans.chars, plans.legs, plans.kinds, out.valid,
+                                  out.target, out.scores, out.terms, out.counters, out.slice_level])
             self.events.append(ev)
 
     def save(self, path, model: CrowdModel, summary: SimulationSummary, meta: dict) -> None:
@@ -238,8 +240,11 @@ def cruising(model: CrowdModel, state: CrowdState, goal_speed: np.ndarray) -> np
 
 
 def simulate(model: CrowdModel, state: CrowdState, frames: int, recorder: Recorder | None = None,
-             progress=None) -> SimulationSummary:
-    """Run ``frames`` steps; never raises on a foot that cannot step (it holds)."""
+             progress=None, on_step=None) -> SimulationSummary:
+    """Run ``frames`` steps; never raises on a foot that cannot step (it holds).
+
+    ``progress(done)`` is called after each frame with the frames done; ``on_step(done, record)`` also
+    gets what the step did (planner._crowd.StepRecord: its timings and the feet it planned)."""
     frame_ms = np.zeros(frames)
     stage_s = np.zeros((frames, len(STAGES)))
     counters = FrameCounters(model, state)
@@ -260,7 +265,8 @@ def simulate(model: CrowdModel, state: CrowdState, frames: int, recorder: Record
     first_second = int(round(1.0 / model.dt))
     for k in range(frames):
         before = state.pelvis[:, [0, 2]].copy()
-        timings = step(model, state)
+        record = step(model, state)
+        timings = record.timings
         landed = state.in_stance & ~prev_stance
         strides.update(k, state, landed)
         walking = ~arrived(model, state)
@@ -282,7 +288,9 @@ def simulate(model: CrowdModel, state: CrowdState, frames: int, recorder: Record
         finite = finite and bool(np.isfinite(state.pelvis).all() and np.isfinite(state.feet).all()
                                  and np.isfinite(state.angles).all())
         if recorder is not None:
-            recorder.capture(k, state, timings)
+            recorder.capture(k, state, record)
+        if on_step is not None:
+            on_step(k + 1, record)
         if progress is not None:
             progress(k + 1)
     c = state.counters

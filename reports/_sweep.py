@@ -26,8 +26,8 @@ requests by :func:`run_paired` (interleaved, best of :data:`TIMING_REPEATS`): th
 frame timings of separate runs move by +-20 % with the load of the machine.
 
 A fixed budget is the crowd's own setting (``init_crowd(..., budget=...)``); the
-requests of a frame are read from the crowd's state after the frame
-(``state.last_batch``, ``state.last_plans``), so nothing in the planner is wrapped.
+requests of a frame are what the step returns
+(:class:`planner._crowd.StepRecord`'s ``plans``), so nothing in the planner is wrapped.
 """
 
 from __future__ import annotations
@@ -213,23 +213,24 @@ class PlanTap:
         self.timed_feet = 0
         self.sample = None  # (batch, result, foot index, weights, config, interest) for the Fig. 13 heatmap
 
-    def record(self, model, state) -> None:
-        """After a frame: keep the frame's planning calls (if it planned) for the next flush.
+    def record(self, model, state, plans) -> None:
+        """After a frame: keep the frame's planning calls (``plans``, planner._crowd.FramePlans, None if it
+        planned nothing) for the next flush.
 
         With a LOD mode a frame may plan in several calls (the far characters' on compact maps,
         ``planner._far_planning``); their requests are put back on the paper's 70 x 70 maps (built
         here, outside the frame timings) so that the exhaustive reference of every plan is the same
         search on the same maps, whatever the level of detail that planned it. Each plan keeps its
         character's level (``self.levels``)."""
-        if not self.capture or state.last_plans is None:
+        if not self.capture or plans is None:
             return
-        cs, _, _, out = state.last_plans
-        if state.last_batch is not None and len(state.last_groups) <= 1:
-            self.pending.append((state.last_batch, out, model.weights, model.config, state.lod_level[cs]))
+        cs, out = plans.chars, plans.result
+        if plans.batch is not None and len(plans.calls) <= 1:
+            self.pending.append((plans.batch, out, model.weights, model.config, state.lod_level[cs]))
             return
         from planner._crowd import _boxes_now, stage_maps
 
-        for batch, config, rows, chars in state.last_groups:
+        for batch, config, rows, chars in plans.calls:
             if config is not model.config:
                 elev, ground, forb, origin = stage_maps(model, state, chars, _boxes_now(model, state.t), count=False)
                 batch = dataclasses.replace(batch, elevation=elev, ground=ground, forbidden=forb, origins=origin)
@@ -402,11 +403,11 @@ def _run_crowd(task: dict, recorder_frames: bool = True, keep_every: int = 0, ke
     recorder = Recorder(model, state, task["frames"]) if recorder_frames else None
     tap.capture = True
 
-    def after_frame(_k):
-        tap.record(model, state)
+    def after_frame(_k, record):
+        tap.record(model, state, record.plans)
         tap.flush()
 
-    summary = simulate(model, state, task["frames"], recorder, progress=after_frame)
+    summary = simulate(model, state, task["frames"], recorder, on_step=after_frame)
     return scenario, model, state, summary, recorder, tap
 
 

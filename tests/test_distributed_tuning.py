@@ -50,12 +50,11 @@ def sequential_harvest(scenarios, creatures, *, seeds, frames, n_characters, wei
                                               weights=weights, timing=timing, lod_mode="off", raster=raster)
                     meta = {"creature": ci, "scenario": si, "seed": int(seed)}
                     for _ in range(frames):
-                        step(model, state)
-                        if state.last_plans is None:
+                        plans = step(model, state).plans
+                        if plans is None:
                             continue
-                        cs, ls, kinds, out = state.last_plans
-                        _harvest_batch(state.last_batch, model.weights, model.config, out, cs, ls, kinds, state,
-                                       model, meta, rows)
+                        _harvest_batch(plans.batch, model.weights, model.config, plans.result, plans.chars, plans.legs,
+                                       plans.kinds, state, model, meta, rows)
                         if max_situations is not None and len(rows) >= max_situations:
                             return _pack(rows, creatures, scenarios, weights.to_array(), timing.to_array())
         return _pack(rows, creatures, scenarios, weights.to_array(), timing.to_array())

@@ -126,12 +126,12 @@ def test_far_characters_near_a_moving_box_plan_on_the_papers_maps_with_more_coup
     model, state = _crowd("on", 12, lod=far)
     seen = 0
     for _ in range(40):
-        step(model, state)
-        if state.last_plans is None:
+        plans = step(model, state).plans
+        if plans is None:
             continue
-        cs = state.last_plans[0]
+        cs = plans.chars
         near = state.near_moving_box[cs]
-        for batch, config, rows, chars in state.last_groups:
+        for batch, config, rows, chars in plans.calls:
             moved = state.near_moving_box[cs[rows]]
             if config is model.config:
                 assert batch.elevation.shape[1] == model.config.map_cells
@@ -139,7 +139,7 @@ def test_far_characters_near_a_moving_box_plan_on_the_papers_maps_with_more_coup
                 seen += int(moved.sum())
             else:
                 assert not moved.any()  # far planning only away from moving boxes
-        assert near.sum() == sum(int(state.near_moving_box[cs[rows]].sum()) for _, c, rows, _ in state.last_groups
+        assert near.sum() == sum(int(state.near_moving_box[cs[rows]].sum()) for _, c, rows, _ in plans.calls
                                  if c is model.config)
     assert seen > 0  # the crowd met a moving box
     assert (state.lod_level == LEVEL_FAR).all()  # ... and its IK kept its level

@@ -197,7 +197,7 @@ def run_event_task(task: dict) -> dict:
 
         started = int(round(1.0 / model.dt))
 
-        def after(k):
+        def after(k, record):
             now = state.pelvis[:, [0, 2]]
             walking = ~arrived(model, state) & (k > started)
             walked[walking] += np.hypot(*(now - before[0]).T)[walking]
@@ -209,14 +209,14 @@ def run_event_task(task: dict) -> dict:
                 centres, yaws = obstacles.poses_at(state.t)
                 feet = state.feet[landed][:, [0, 2]]
                 clearance.append(box_distance(feet, centres[forbidden][:, [0, 2]], half, yaws[forbidden]).min(axis=1))
-            if state.last_plans is not None:
-                out = state.last_plans[3]
+            if record.plans is not None:
+                out = record.plans.result
                 ok = out.valid
                 curvature.append(out.raw[ok, RAW_CURVATURE])
                 slope.append((1.0 - out.terms[ok, 2]) * w[W_SLOPE_CRITICAL])
                 rough.append((1.0 - out.terms[ok, 1]) * w[W_STEP_CRITICAL])
 
-        summary = simulate(model, state, task["frames"], progress=after).to_json()
+        summary = simulate(model, state, task["frames"], on_step=after).to_json()
 
     def cat(parts):
         return np.concatenate(parts) if parts else np.zeros(0)

@@ -157,18 +157,18 @@ def run_one(creature_name: str, scenario_name: str, seed: int, speed: float, wei
     pelvis = np.zeros((measured,) + state.pelvis.shape)
     raw = []
 
-    def after(k):
+    def after(k, record):
         j = k - 1 - warmup
         if j < 0:
             return
         feet[j] = state.feet
         stance[j] = state.in_stance
         pelvis[j] = state.pelvis
-        if state.last_plans is not None:
-            out = state.last_plans[3]
+        if record.plans is not None:
+            out = record.plans.result
             raw.append(out.raw[out.valid])
 
-    summary = simulate(model, state, frames, progress=after)
+    summary = simulate(model, state, frames, on_step=after)
     v, stride = realised_strides(feet, stance, pelvis, model.dt)
     walking = v > STRIDE_MIN_SPEED
     raw = np.concatenate(raw) if raw else np.zeros((0, 5))
