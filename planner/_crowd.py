@@ -351,7 +351,7 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
     goal_speed = np.where(arrived, 0.0, np.minimum(np.minimum(state.desired_speed, state.speed_limit), braking))
     state.goal_speed = goal_speed
     preferred = direction * goal_speed[:, None]
-    velocity, avoided = _avoid(model, state, preferred, dist, boxes, box_velocity, in_lane)
+    velocity, avoided, among_others = _avoid(model, state, preferred, dist, boxes, box_velocity, in_lane)
     fast = np.hypot(velocity[:, 0], velocity[:, 1]) > 1e-6
     # Escaping a moving box's lane, ORCA's velocity can point back along the lane, away from the box:
     # as it crosses behind the character its angle flipped between +2.9 and -2.9 rad and the turn
@@ -359,8 +359,7 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
     # character turns out of the lane, to the side the lane exit chose, and walks only as far along
     # its heading as ORCA's velocity goes.
     backward = in_lane & avoided & fast & ((velocity * direction).sum(axis=1) < 0.0)
-    if backward.any():
-        backward &= ~_near_others(model, state, backward)
+    backward &= ~among_others
     direction = np.where((avoided & fast & ~backward)[:, None],
                          velocity / np.maximum(np.hypot(*velocity.T), 1e-12)[:, None], direction)
     desired = np.arctan2(direction[:, 1], direction[:, 0])
@@ -430,7 +429,7 @@ AVOID_NEIGHBOURS = 10
 """Nearest characters each one avoids (ORCA's usual cap: the rest are further than these)."""
 NEAR_RADII = 4.0
 """x avoid radius: a character with another this near is among neighbours: it aims KEEP_RIGHT right of
-its way (:func:`_avoid`), and escaping a moving box it follows ORCA's velocity (:func:`_near_others`)."""
+its way, and escaping a moving box it follows ORCA's velocity (both in :func:`_avoid`)."""
 KEEP_RIGHT = 0.1
 """rad: a character with a neighbour near aims this much right of its way; ORCA alone can settle
 in a symmetric standstill (two characters exactly head-on), a shared convention breaks the tie."""
@@ -551,23 +550,11 @@ def _time_to_contact(ways, speed, rel, box_velocity, u, side_axis, reach_along, 
     return np.minimum(when.min(axis=2), LANE_HORIZON)
 
 
-def _near_others(model: CrowdModel, state: CrowdState, rows: np.ndarray) -> np.ndarray:
-    """(C,) bool: the characters of ``rows`` (C,) bool with another character within :data:`NEAR_RADII`
-    avoid radii (the test :func:`_avoid` makes on its neighbour lists, for the few rows asked)."""
-    from scipy.spatial import cKDTree
-
-    xz = state.pelvis[:, [0, 2]]
-    out = np.zeros(xz.shape[0], np.bool_)
-    idx = np.flatnonzero(rows)
-    counts = cKDTree(xz).query_ball_point(xz[idx], NEAR_RADII * model.avoid_radius, return_length=True)
-    out[idx] = np.asarray(counts) > 1
-    return out
-
-
 def _avoid(model: CrowdModel, state: CrowdState, preferred: np.ndarray, to_target: np.ndarray, boxes,
            box_velocity: np.ndarray, escaping: np.ndarray):
-    """(velocity (C, 2), avoided (C,) bool): ORCA's velocity for every character, and whether it
-    differs from the preferred one (a neighbour or a box is in the way). ``boxes`` as
+    """(velocity (C, 2), avoided (C,) bool, near (C,) bool): ORCA's velocity for every character, whether it
+    differs from the preferred one (a neighbour or a box is in the way), and whether another character is
+    within :data:`NEAR_RADII` avoid radii (among neighbours). ``boxes`` as
     :func:`_boxes_now` gives them, ``box_velocity`` from :func:`_box_velocities`; ``escaping`` (C,)
     bool: characters leaving a moving box's lane, whom their neighbours make way for."""
     from planner._kernels_avoidance import neighbour_lists, orca_velocities
@@ -576,7 +563,10 @@ def _avoid(model: CrowdModel, state: CrowdState, preferred: np.ndarray, to_targe
     xz = np.ascontiguousarray(state.pelvis[:, [0, 2]])
     radius = model.avoid_radius
     top = model.top_speed if math.isfinite(model.top_speed) else float(np.max(state.desired_speed))
-    start, index = neighbour_lists(xz, 2.0 * radius + 2.0 * top * AVOID_HORIZON, AVOID_NEIGHBOURS)
+    # The lists reach at least NEAR_RADII avoid radii, so the nearest other character, if that near, is in
+    # its character's list: 'near' below is 'another character within NEAR_RADII avoid radii'.
+    start, index = neighbour_lists(xz, max(2.0 * radius + 2.0 * top * AVOID_HORIZON, NEAR_RADII * radius),
+                                   AVOID_NEIGHBOURS)
     near = np.zeros(n, np.bool_)
     if index.size:
         rows = np.repeat(np.arange(n), np.diff(start))
@@ -606,7 +596,7 @@ def _avoid(model: CrowdModel, state: CrowdState, preferred: np.ndarray, to_targe
                     np.full(n, top), start, index, *orca_boxes, AVOID_HORIZON, AVOID_BOX_HORIZON, model.dt,
                     np.ascontiguousarray(escaping), mobile, out)
     avoided = np.hypot(*(out - preferred).T) > 1e-9
-    return out, avoided
+    return out, avoided, near
 
 
 def stance_room(model: CrowdModel, state: CrowdState) -> np.ndarray:

@@ -112,7 +112,7 @@ def test_a_crate_crossing_a_planned_swing_replans_it_the_same_frame(tmp_path, mo
     import planner._crowd as crowd
 
     monkeypatch.setattr(crowd, "_avoid", lambda model, state, preferred, *_: (
-        preferred, np.zeros(preferred.shape[0], np.bool_)))
+        preferred, np.zeros(preferred.shape[0], np.bool_), np.zeros(preferred.shape[0], np.bool_)))
 
     model, state = _world(tmp_path, "across-swing", crate_centre=(-1.1, -4.0), crate_width=0.2, start=(-2.0, 0.0),
                           goal=(4.0, 0.0), velocity=(0.0, 2.0))
@@ -206,13 +206,13 @@ def test_avoidance_keeps_a_forbidden_crate_clear_of_the_body_for_its_horizon(tmp
     r = model.avoid_radius
     assert 0.0 < d - r < 0.3 * AVOID_BOX_HORIZON, "the crate must be near enough to bind a 0.3 m/s walk"
     preferred = np.array([[0.3, 0.0]])
-    velocity, avoided = _avoid(model, state, preferred, np.array([3.0]), boxes,
+    velocity, avoided, _ = _avoid(model, state, preferred, np.array([3.0]), boxes,
                                _box_velocities(model, state.t, boxes[0]), np.zeros(1, np.bool_))
     assert avoided[0]
     assert velocity[0, 0] <= (d - r) / AVOID_BOX_HORIZON + 1e-9
     assert velocity[0, 0] == pytest.approx((d - r) / AVOID_BOX_HORIZON, abs=1e-6)  # no slower than it must
     # Walking away from it: nothing to avoid.
-    velocity, avoided = _avoid(model, state, -preferred, np.array([3.0]), boxes,
+    velocity, avoided, _ = _avoid(model, state, -preferred, np.array([3.0]), boxes,
                                _box_velocities(model, state.t, boxes[0]), np.zeros(1, np.bool_))
     assert not avoided[0] and velocity[0] == pytest.approx(-preferred[0])
 
@@ -240,7 +240,7 @@ def test_a_character_standing_still_is_avoided_with_the_whole_effort(tmp_path, m
 
     def a_velocity():
         # to_target under the keep-right distance: A's preferred velocity is its velocity.
-        velocity, avoided = crowd._avoid(model, state, preferred, np.array([0.5, 0.5]), boxes, np.zeros((0, 2)),
+        velocity, avoided, _ = crowd._avoid(model, state, preferred, np.array([0.5, 0.5]), boxes, np.zeros((0, 2)),
                                          np.zeros(2, np.bool_))
         assert avoided[0]
         return velocity[0] - preferred[0]
@@ -536,12 +536,10 @@ def test_an_escape_whose_orca_velocity_points_back_turns_to_the_lane_exits_side(
 
     def back_to_the_other_side(*a, **k):
         side = np.sign(exits[-1][1])  # the exit's side along z (it squares out of a lane along x)
-        return np.array([[-0.2, -0.02 * side]]), np.array([True])
+        return np.array([[-0.2, -0.02 * side]]), np.array([True]), np.array([neighbour])
 
     monkeypatch.setattr(crowd, "_lane_exit", recorded_exit)
     monkeypatch.setattr(crowd, "_avoid", back_to_the_other_side)
-    if neighbour:
-        monkeypatch.setattr(crowd, "_near_others", lambda model, state, rows: rows.copy())
     stage_steer(model, state, _boxes_now(model, state.t))
     side = np.sign(exits[-1][1])
     assert state.escaping[0] and side != 0.0 and abs(exits[-1][0]) < 1e-12  # square out of the lane
