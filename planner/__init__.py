@@ -20,6 +20,7 @@ from planner._crowd import (  # noqa: E402
     init_crowd,
     planner_config_for,
     step,
+    sustained_speed,
 )
 from planner._gait import GaitManagerState, advance, init_gaits, set_destination, set_speed  # noqa: E402
 from planner._grid import GridFrame  # noqa: E402
@@ -36,7 +37,15 @@ from planner._params import (  # noqa: E402
 )
 from planner._presets import PRESET_SCHEMA_VERSION, Preset, load_preset, preset_dict  # noqa: E402
 from planner._search import COUNTERS, RAW_METRICS, CoupleResult, FootQuery, plan_foot, wavefront_distances  # noqa: E402
-from planner._simulation import RECORDING_VERSION, Recorder, SimulationSummary, arrived, realised_strides, simulate  # noqa: E402
+from planner._simulation import (  # noqa: E402
+    RECORDING_VERSION,
+    Recorder,
+    SimulationSummary,
+    arrived,
+    asked_speed,
+    realised_strides,
+    simulate,
+)
 from planner._threads import single_threaded  # noqa: E402
 from planner._timing import (  # noqa: E402
     GRAVITY,
@@ -83,6 +92,7 @@ __all__ = [
     "WEIGHT_FIELDS",
     "advance",
     "arrived",
+    "asked_speed",
     "BatchResult",
     "body_rotation",
     "ControllerConfig",
@@ -137,6 +147,7 @@ __all__ = [
     "stride_frequency",
     "stride_law",
     "stride_length",
+    "sustained_speed",
     "task_mapper",
     "wavefront_distances",
     "WorldRaster",

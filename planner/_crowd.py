@@ -269,6 +269,12 @@ def hips_world(model: CrowdModel, state: CrowdState) -> np.ndarray:
     return state.pelvis[:, None, :] + rotated
 
 
+def sustained_speed(state: CrowdState) -> np.ndarray:
+    """(C,) m/s: the speed each character heads for while it walks: the speed asked of it, held to the
+    limit its legs showed they sustain (lowered by holds, ControllerConfig.hold_backoff)."""
+    return np.minimum(state.desired_speed, state.speed_limit)
+
+
 def _landing_feet(state: CrowdState) -> np.ndarray:
     """(C, L, 3) where each foot stands, or, swinging, lands."""
     return np.where(state.in_stance[..., None], state.feet, state.swing_target)
@@ -348,7 +354,7 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
     # Arriving: on the last leg of its route a character brakes in time (at its acceleration) to
     # stop within the arrive radius; braking only once inside it overshot the goal by a metre at a trot.
     braking = np.where(state.route_index == last, arrival_speed(dist, ctl.arrive_radius, ctl.acceleration), np.inf)
-    goal_speed = np.where(arrived, 0.0, np.minimum(np.minimum(state.desired_speed, state.speed_limit), braking))
+    goal_speed = np.where(arrived, 0.0, np.minimum(sustained_speed(state), braking))
     state.goal_speed = goal_speed
     preferred = direction * goal_speed[:, None]
     velocity, avoided, among_others = _avoid(model, state, preferred, dist, boxes, box_velocity, in_lane)
@@ -589,7 +595,7 @@ def _avoid(model: CrowdModel, state: CrowdState, preferred: np.ndarray, to_targe
     # and turns slowly, so the others steer round it as round a box (left half the effort, or given
     # way by it when escaping a box's lane, one walked into a spider standing in its path at 0.29 m/s:
     # 63 overlapping frames, mixed, seed 1121411189).
-    goal = np.minimum(state.desired_speed, state.speed_limit)
+    goal = sustained_speed(state)
     mobile = (state.speed >= MOBILE_FRACTION * goal) & ~state.body_held
     out = np.empty((n, 2))
     orca_velocities(xz, np.ascontiguousarray(velocity), np.ascontiguousarray(preferred), np.full(n, radius),
@@ -621,7 +627,7 @@ def resume_frequency(model: CrowdModel, state: CrowdState) -> np.ndarray:
     from planner._timing import _stride_frequency
 
     # Three calls a frame: the checks of the public stride_frequency cost as much as the formula.
-    return _stride_frequency(model.timing, np.minimum(state.desired_speed, state.speed_limit), model.leg_height)
+    return _stride_frequency(model.timing, sustained_speed(state), model.leg_height)
 
 
 def leg_speed_caps(model: CrowdModel, state: CrowdState, room=None, lift=None) -> np.ndarray:
@@ -720,7 +726,7 @@ def stage_gait(model: CrowdModel, state: CrowdState):
     # a body slowed for a stride by its legs would otherwise flip gaits and restart transitions.
     schedule = model.schedule
     if len(schedule.gaits) > 1:
-        goal = np.minimum(state.desired_speed, state.speed_limit)
+        goal = sustained_speed(state)
         froude = goal**2 / (GRAVITY * model.leg_height)
         index = schedule.select(state.gait_index, froude)
         for k in np.unique(index[index != state.gait_index]):
@@ -938,7 +944,7 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, fre
     # ahead of a body slowed on a hill, made robot5's front legs step twice a cycle (strides 40-60 %
     # off the law). A body turning on the spot does not walk toward them, nor does one near a moving
     # box: it turns away from the box, off the heading the foot is ahead along.
-    walking = state.speed >= 0.5 * np.minimum(state.desired_speed, state.speed_limit)
+    walking = state.speed >= 0.5 * sustained_speed(state)
     walking &= ~moving_box_near(model, state, boxes)
     dx, dz = state.feet[..., 0] - hips[..., 0], state.feet[..., 2] - hips[..., 2]
     ahead = walking[:, None] & (dx * np.cos(state.heading)[:, None] + dz * np.sin(state.heading)[:, None] > 0.0)
@@ -1178,7 +1184,7 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     v = state.speed[cs]
     # Where the body will be: it keeps accelerating toward its goal speed (a foot planned at the
     # start of a speed-up would otherwise land for the slower speed and trail out of reach).
-    goal = np.minimum(state.desired_speed[cs], state.speed_limit[cs])
+    goal = sustained_speed(state)[cs]
     travel_swing = travel(v, goal, model.controller.acceleration, t_swing)
     pred = state.pelvis[cs][:, [0, 2]] + fwd * travel_swing[:, None]
     spacing = state.feet_spacing[cs]

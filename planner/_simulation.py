@@ -165,13 +165,19 @@ def realised_strides(feet, in_stance, pelvis, dt: float):
     return (moved / ((k1 - k0) * dt)).astype(np.float64), stride.astype(np.float64)
 
 
+def asked_speed(model: CrowdModel, state: CrowdState) -> np.ndarray:
+    """(C,) m/s: the speed asked of each character, capped where even the least duty factor does not fit
+    its legs' stance windows (``model.speed_cap``): what the stride and speed bars are measured against."""
+    return np.minimum(state.desired_speed, model.speed_cap)
+
+
 class StrideMeter:
     """Per-stride error against the commanded stride law, measured frame by frame (module doc)."""
 
     def __init__(self, model: CrowdModel, state: CrowdState):
         c, l = state.in_stance.shape
         self.model = model
-        self.goal = np.minimum(state.desired_speed, model.speed_cap)
+        self.goal = asked_speed(model, state)
         self.last_frame = np.full((c, l), -1, np.int64)
         self.last_foot = np.zeros((c, l, 2))
         self.last_pelvis = np.zeros((c, l, 2))

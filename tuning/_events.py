@@ -170,7 +170,16 @@ def replay_command(task: dict, preset: str = "PRESET.json") -> str:
 def run_event_task(task: dict) -> dict:
     """One run of :func:`event_tasks`: the simulation's summary and the plan metrics (picklable)."""
     from footfall._runs import resolve_gait
-    from planner import GaitTiming, ScoringWeights, arrived, hip_height, init_crowd, simulate, single_threaded
+    from planner import (
+        GaitTiming,
+        ScoringWeights,
+        arrived,
+        asked_speed,
+        hip_height,
+        init_crowd,
+        simulate,
+        single_threaded,
+    )
     from planner.layout import W_SLOPE_CRITICAL, W_STEP_CRITICAL
     from scenarios import load_creature, load_scenario
 
@@ -185,7 +194,7 @@ def run_event_task(task: dict) -> dict:
                                   weights=weights, timing=timing, lod_mode="off")
         w = weights.to_array()
         h = hip_height(creature)
-        goal = np.minimum(state.desired_speed, model.speed_cap)
+        goal = asked_speed(model, state)
         curvature, slope, rough, clearance = [], [], [], []
         obstacles = model.raster.obstacles
         forbidden = np.asarray(obstacles.forbidden, dtype=np.bool_) if len(obstacles.yaws) else np.zeros(0, bool)
