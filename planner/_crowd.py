@@ -43,8 +43,8 @@ from planner._counters import rendered_joints
 from planner._kernels_controller import (
     advance_swings,
     count_forbidden_landings,
-    foot_box_conflict,
     legs_crossed_by_turn,
+    points_in_boxes,
     stance_legs_crossing,
     stance_threatened,
     swings_invalidated,
@@ -1329,15 +1329,16 @@ def tuck_points(model: CrowdModel, state: CrowdState, cs, ls, hips, boxes=None) 
     if boxes is None or not len(boxes[0]):
         return points
     centres, sizes, yaws, forbidden, _ = boxes
-    every = np.ones(len(yaws), np.bool_)
     hx, hz = 0.5 * model.creature.foot_length, 0.5 * model.creature.foot_width
     yaw = state.foot_yaws[cs, ls]
 
     def inside(rows):
-        return np.array([foot_box_conflict(*points[r], hx, hz, yaw[r], 0.0, centres, sizes, yaws, forbidden, every)
-                         for r in rows], np.bool_)
+        out = np.empty(len(rows), np.bool_)
+        points_in_boxes(np.ascontiguousarray(points[rows]), hx, hz, np.ascontiguousarray(yaw[rows]), centres, sizes, yaws,
+                        forbidden, out)
+        return out
 
-    blocked = np.flatnonzero(inside(range(len(cs))))
+    blocked = np.flatnonzero(inside(np.arange(len(cs))))
     for reach in TUCK_REACHES[1:]:
         if not blocked.size:
             break

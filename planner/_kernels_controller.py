@@ -88,6 +88,16 @@ def swings_invalidated(in_stance, swing_t, swing_T, trajectories, foot_hx, foot_
                     break
 
 
+@nb.njit(cache=True)
+def points_in_boxes(points, foot_hx, foot_hz, foot_yaws, box_centres, box_sizes, box_yaws, box_forbidden, out):
+    """Feet (a foot's box of half extents ``foot_hx``, ``foot_hz`` at each of ``points`` (F, 3), turned by
+    ``foot_yaws`` (F,)) that overlap a box below its top (forbidden: at any height), into ``out`` (F,) bool."""
+    every = np.ones(box_centres.shape[0], dtype=np.bool_)
+    for f in range(points.shape[0]):
+        out[f] = foot_box_conflict(points[f, 0], points[f, 1], points[f, 2], foot_hx, foot_hz, foot_yaws[f], 0.0,
+                                   box_centres, box_sizes, box_yaws, box_forbidden, every)
+
+
 @nb.njit(cache=True, parallel=True)
 def stance_threatened(in_stance, feet, foot_hx, foot_hz, foot_yaws, margin, box_centres, box_sizes, box_yaws,
                       box_forbidden, box_moving, out):
