@@ -26,6 +26,22 @@ import numpy as np
 from planner._grid import cell_centre, cell_of
 from planner._kernels_geometry import segment_point_distance, segments_cross, supercover_visit
 from planner._kernels_wavefront import chamfer_distance
+from planner._weights import (
+    N_FOOTPRINT_TERMS,
+    N_TERMS,
+    W_CLEARANCE_REF,
+    W_CLIMB_REF,
+    W_CURVATURE_REF,
+    W_DISTANCE_SCALE,
+    W_JERK_REF,
+    W_LEG_SPACING_REF,
+    W_PROXIMITY_REF,
+    W_SLOPE_CRITICAL,
+    W_STEP_CRITICAL,
+    falling_goodness,
+    rational_goodness,
+    rising_goodness,
+)
 # The raw trajectory metrics (RAW_*), footprint features (FEAT_*) and counters (CNT_*), in the order of the
 # results: planner.layout.
 from planner.layout import (  # noqa: F401  (re-exported: the kernels' callers read them from here too)
@@ -48,22 +64,6 @@ from planner.layout import (  # noqa: F401  (re-exported: the kernels' callers r
     RAW_CURVATURE,
     RAW_JERK,
     RAW_LENGTH,
-)
-from planner._weights import (
-    N_FOOTPRINT_TERMS,
-    N_TERMS,
-    W_CLEARANCE_REF,
-    W_CLIMB_REF,
-    W_CURVATURE_REF,
-    W_DISTANCE_SCALE,
-    W_JERK_REF,
-    W_LEG_SPACING_REF,
-    W_PROXIMITY_REF,
-    W_SLOPE_CRITICAL,
-    W_STEP_CRITICAL,
-    falling_goodness,
-    rational_goodness,
-    rising_goodness,
 )
 
 # Codes of the per-foot obstacles' map (ROI).
@@ -89,7 +89,6 @@ DENSE_SPACING_MAX = 0.40  # a chord between dense samples may not be longer (cel
 JERK_SAMPLES = 48
 U_LO = 0.05  # curvature and jerk are evaluated for u in [U_LO, U_HI] (singular at the ends)
 U_HI = 0.95
-
 
 
 @nb.njit(cache=True)
