@@ -23,6 +23,7 @@ from planner._kernels_foot import footprint_candidates, prepare_foot, slice_maps
 from planner._kernels_geometry import foot_offsets
 from planner._kernels_wavefront import per_target_wavefronts, wavefront
 from planner._search import MODES
+from planner.layout import N_COUNTERS, N_RAW, N_TERMS
 from scenarios import load_creature, load_scenario
 
 from benchmarks._situations import scenario_situations
@@ -46,7 +47,8 @@ def _per_foot_us(batch, weights, config, repeats: int) -> np.ndarray:
     k = config.trajectory_samples
     times = np.empty(batch.n_feet)
     outs = FootResults(np.zeros(1, np.bool_), np.zeros((1, 3)), np.zeros(1, np.int64), np.zeros(1), np.zeros((1, 3)),
-                       np.zeros((1, 10)), np.zeros((1, 5)), np.zeros((1, 6), np.int64), np.zeros((1, k, 3)))
+                       np.zeros((1, N_TERMS)), np.zeros((1, N_RAW)), np.zeros((1, N_COUNTERS), np.int64),
+                       np.zeros((1, k, 3)))
     for i in range(batch.n_feet):
         ls, le = batch.legs_start[i], batch.legs_start[i + 1]
         ch = batch.foot_char[i]

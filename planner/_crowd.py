@@ -891,15 +891,15 @@ def _stance_unreachable_ahead(model: CrowdModel, state: CrowdState, hips, freque
     # Each character is checked every ``lookahead_every`` frames (in turns, so the cost is
     # spread); the look-ahead horizon covers the frames in between.
     turn = (np.arange(state.pelvis.shape[0]) + state.frame) % ctl.lookahead_every == 0
+    far_chars = _characters_at(model, state, LEVEL_FAR)
     if model.lod_mode != "off":
         # A far character (LOD) looks ahead half as often, within the horizon the check covers.
         every = min(2 * ctl.lookahead_every, ctl.lookahead_frames)
-        far = _two_bone_characters(model, state)
-        turn = np.where(far, (np.arange(far.size) + state.frame) % every == 0, turn)
+        turn = np.where(far_chars, (np.arange(far_chars.size) + state.frame) % every == 0, turn)
     # A hidden character (LOD, off screen) is looked ahead too, with the two-bone solve: unchecked, its
     # body walked off a stance foot while hidden, and the first solve on screen missed it by 2-3 cm
     # (a 27-32 mm slip: crates-moving and mixed, quadrupeds, LOD zoomed).
-    hidden = _hidden_characters(model, state)
+    hidden = _characters_at(model, state, LEVEL_HIDDEN)
     cs, ls = np.nonzero(state.in_stance & ((state.ik_on | hidden) & turn)[:, None])
     if cs.size == 0:
         return out.copy()
@@ -920,7 +920,7 @@ def _stance_unreachable_ahead(model: CrowdModel, state: CrowdState, hips, freque
     rise = np.maximum(state.pelvis_rise[cs], 0.0)
     shifted[:, 1] += np.minimum((horizon / model.dt) * rise, rise + ahead * np.maximum(np.tan(state.pitch[cs]), 0.0))
     # A far character (LOD) looks ahead with its own IK, the two-bone solve; a hidden one too.
-    two_bone = (_two_bone_characters(model, state) | hidden)[cs]
+    two_bone = (far_chars | hidden)[cs]
     for far in (False, True) if two_bone.any() else (False,):
         k = np.flatnonzero(two_bone == far)
         if k.size == 0:
@@ -1486,7 +1486,7 @@ def stage_ik(model: CrowdModel, state: CrowdState, on_screen: np.ndarray) -> Non
         return
     hips = hips_world(model, state)
     ctl = model.controller
-    far = _two_bone_characters(model, state) & on_screen
+    far = _characters_at(model, state, LEVEL_FAR) & on_screen
     for stance, restarts, iterations in ((True, ctl.ik_restarts, ctl.ik_iterations), (False, ctl.ik_restarts, ctl.ik_swing_iterations)):
         cs, ls = np.nonzero((on_screen & ~far)[:, None] & (state.in_stance == stance))
         if cs.size == 0:
@@ -1514,18 +1514,12 @@ def stage_ik(model: CrowdModel, state: CrowdState, on_screen: np.ndarray) -> Non
     _take_back_unfollowed_poses(model, state, on_screen)
 
 
-def _hidden_characters(model: CrowdModel, state: CrowdState) -> np.ndarray:
-    """(C,) the characters off screen (LOD: no IK); none without a LOD mode."""
+def _characters_at(model: CrowdModel, state: CrowdState, level: int) -> np.ndarray:
+    """(C,) the characters at LOD ``level`` (planner._lod.LEVEL_*); none without a LOD mode. LEVEL_FAR:
+    those whose IK is the closed-form two-bone solve; LEVEL_HIDDEN: those off screen (no IK)."""
     if model.lod_mode == "off":
         return np.zeros(state.pelvis.shape[0], np.bool_)
-    return state.lod_level == LEVEL_HIDDEN
-
-
-def _two_bone_characters(model: CrowdModel, state: CrowdState) -> np.ndarray:
-    """(C,) the characters whose IK is the closed-form two-bone solve (LOD: the far ones)."""
-    if model.lod_mode == "off":
-        return np.zeros(state.pelvis.shape[0], np.bool_)
-    return state.lod_level == LEVEL_FAR
+    return state.lod_level == level
 
 
 def _pose(state: CrowdState) -> np.ndarray:

@@ -64,38 +64,33 @@ from planner._weights import (
 )
 
 
-def _indices(names: tuple[str, ...], *wanted: str) -> tuple[int, ...]:
-    """The index of each of ``wanted`` in ``names`` (so a constant cannot disagree with its name)."""
-    return tuple(names.index(n) for n in wanted)
-
-
 FEATURES: tuple[str, ...] = ("distance_m", "roughness_m", "slope_rad", "leg_gap_m", "obstacle_distance_m")
 """Raw footprint features: distance to the preferred footprint, roughness and slope under the foot,
 gap to the other legs, distance to the nearest blocked cell."""
-FEAT_DISTANCE, FEAT_ROUGHNESS, FEAT_SLOPE, FEAT_LEG_GAP, FEAT_PROXIMITY = _indices(FEATURES, *FEATURES)
+FEAT_DISTANCE, FEAT_ROUGHNESS, FEAT_SLOPE, FEAT_LEG_GAP, FEAT_PROXIMITY = range(len(FEATURES))
 N_FEATURES = len(FEATURES)
 
 RAW_METRICS: tuple[str, ...] = ("length_m", "curvature_energy", "clearance_m", "climb_m", "jerk")
 """Raw trajectory metrics of a swing path."""
-RAW_LENGTH, RAW_CURVATURE, RAW_CLEARANCE, RAW_CLIMB, RAW_JERK = _indices(RAW_METRICS, *RAW_METRICS)
+RAW_LENGTH, RAW_CURVATURE, RAW_CLEARANCE, RAW_CLIMB, RAW_JERK = range(len(RAW_METRICS))
 N_RAW = len(RAW_METRICS)
 
 COUNTERS: tuple[str, ...] = ("couples_evaluated", "couples_2d", "cells_expanded", "wavefronts", "candidates", "slices")
 """The search's counters of one foot."""
-CNT_COUPLES_3D, CNT_COUPLES_2D, CNT_EXPANDED, CNT_WAVEFRONTS, CNT_CANDIDATES, CNT_SLICES = _indices(COUNTERS, *COUNTERS)
+CNT_COUPLES_3D, CNT_COUPLES_2D, CNT_EXPANDED, CNT_WAVEFRONTS, CNT_CANDIDATES, CNT_SLICES = range(len(COUNTERS))
 N_COUNTERS = len(COUNTERS)
 
 SCORES: tuple[str, ...] = ("couple", "footprint", "trajectory")
 """The three scores of a planned couple."""
-SCORE_COUPLE, SCORE_FOOTPRINT, SCORE_TRAJECTORY = _indices(SCORES, *SCORES)
+SCORE_COUPLE, SCORE_FOOTPRINT, SCORE_TRAJECTORY = range(len(SCORES))
 
 SEARCH_MODES: tuple[str, ...] = ("search", "per_target", "brute_force")
 """How the couple search runs: the paper's search, one wavefront per target, every couple."""
-MODE_SEARCH, MODE_PER_TARGET, MODE_BRUTE_FORCE = _indices(SEARCH_MODES, *SEARCH_MODES)
+MODE_SEARCH, MODE_PER_TARGET, MODE_BRUTE_FORCE = range(len(SEARCH_MODES))
 
 REQUEST_KINDS: tuple[str, ...] = ("none", "new_swing", "forced_step", "replan")
 """What the crowd asks of a foot in a frame (``planner._crowd.stage_requests``; the harvest's ``kind``)."""
-KIND_NONE, KIND_NEW_SWING, KIND_FORCED_STEP, KIND_REPLAN = _indices(REQUEST_KINDS, *REQUEST_KINDS)
+KIND_NONE, KIND_NEW_SWING, KIND_FORCED_STEP, KIND_REPLAN = range(len(REQUEST_KINDS))
 
 assert WEIGHT_FIELDS[:N_TERMS] == tuple("footprint_" + t for t in FOOTPRINT_TERMS) + tuple(
     "trajectory_" + t for t in TRAJECTORY_TERMS)
