@@ -6,8 +6,8 @@ import math
 
 import numpy as np
 
-from planner import PlannerConfig, WorldRaster
-from planner._situations import stand, step_queries
+from footfall.planner import PlannerConfig, WorldRaster
+from footfall.planner._situations import stand, step_queries
 
 
 def scenario_situations(scenario, creature, n_poses: int, seed: int, config: PlannerConfig):

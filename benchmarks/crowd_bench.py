@@ -22,9 +22,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from planner import WorldRaster
-from planner._crowd import init_crowd, step
-from scenarios import default_gait_name, load_creature, load_gait, load_scenario
+from footfall.planner import WorldRaster
+from footfall.planner._crowd import init_crowd, step
+from footfall.scenarios import default_gait_name, load_creature, load_gait, load_scenario
 
 MODES = ("on", "zoomed", "off")
 SIZES = (100, 1000, 3000, 5000)
@@ -75,7 +75,7 @@ def run(sizes=(100, 1000), frames: int = 60, warmup: int = 30, seed: int = 0, sc
         name = scenario_for(n, scenario_name)
         scenario = load_scenario(name)
         if name not in rasters:
-            from planner._crowd import planner_config_for
+            from footfall.planner._crowd import planner_config_for
 
             rasters[name] = WorldRaster.build(scenario.terrain, scenario.obstacles,
                                               planner_config_for(creature).cell_size)

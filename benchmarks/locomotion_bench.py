@@ -15,11 +15,11 @@ from __future__ import annotations
 
 import math
 
-from planner._crowd import init_crowd
-from planner._simulation import simulate
-from planner._timing import GRAVITY, hip_height
-from scenarios import load_creature, load_scenario
-from scenarios._gait_schedule import gait_schedule
+from footfall.planner._crowd import init_crowd
+from footfall.planner._simulation import simulate
+from footfall.planner._timing import GRAVITY, hip_height
+from footfall.scenarios import load_creature, load_scenario
+from footfall.scenarios._gait_schedule import gait_schedule
 
 FROUDE = (0.05, 0.2, 0.5)
 SCENARIOS = ("flat", "hills", "stairs")
@@ -70,7 +70,7 @@ def markdown(rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
-if __name__ == "__main__":  # python -m benchmarks.locomotion_bench [creature ...]
+if __name__ == "__main__":  # python -m footfall.benchmarks.locomotion_bench [creature ...]
     import sys
 
     print(markdown(run(creatures=tuple(sys.argv[1:]) or ("spider", "ant", "quadruped", "robot5"),

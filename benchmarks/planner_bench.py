@@ -17,16 +17,16 @@ import time
 
 import numpy as np
 
-from planner import DEFAULT_BUDGET, EXHAUSTIVE, FIRST_VALID, PlannerConfig, ScoringWeights, make_batch
-from planner._kernels_batch import FootRequests, FootResults, plan_feet_serial
-from planner._kernels_foot import footprint_candidates, prepare_foot, slice_maps, swing_reach
-from planner._kernels_geometry import foot_offsets
-from planner._kernels_wavefront import per_target_wavefronts, wavefront
-from planner._search import MODES
-from planner.layout import N_COUNTERS, N_RAW, N_TERMS
-from scenarios import load_creature, load_scenario
+from footfall.planner import DEFAULT_BUDGET, EXHAUSTIVE, FIRST_VALID, PlannerConfig, ScoringWeights, make_batch
+from footfall.planner._kernels_batch import FootRequests, FootResults, plan_feet_serial
+from footfall.planner._kernels_foot import footprint_candidates, prepare_foot, slice_maps, swing_reach
+from footfall.planner._kernels_geometry import foot_offsets
+from footfall.planner._kernels_wavefront import per_target_wavefronts, wavefront
+from footfall.planner._search import MODES
+from footfall.planner.layout import N_COUNTERS, N_RAW, N_TERMS
+from footfall.scenarios import load_creature, load_scenario
 
-from benchmarks._situations import scenario_situations
+from footfall.benchmarks._situations import scenario_situations
 
 BUDGETS = {"first_valid": FIRST_VALID, "default": DEFAULT_BUDGET, "exhaustive": EXHAUSTIVE}
 SCENARIOS = ("crates", "mixed")

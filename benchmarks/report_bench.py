@@ -9,7 +9,7 @@ headless (VTK on EGL), timed from start to exit:
   first run after a kernel changed);
 * ``warm``: again with that cache filled (``repeats`` runs; the table shows each and the median).
 
-Run it with ``python -m benchmarks.report_bench [--repeats N] [--workers N]``.
+Run it with ``python -m footfall.benchmarks.report_bench [--repeats N] [--workers N]``.
 """
 
 from __future__ import annotations
@@ -66,7 +66,7 @@ def markdown(rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
-if __name__ == "__main__":  # python -m benchmarks.report_bench [--repeats N] [--workers N]
+if __name__ == "__main__":  # python -m footfall.benchmarks.report_bench [--repeats N] [--workers N]
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=2, help="warm runs after the first (default 2)")
     parser.add_argument("--workers", type=int, default=None, help="footfall report --workers (default: its own)")

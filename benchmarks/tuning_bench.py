@@ -78,7 +78,7 @@ replaces any of it."""
 def make_config(creature: str, seed: int = 0, rounds: int = 2, config_overrides: dict | None = None):
     """The :class:`tuning._tune.TuneConfig` of the benchmark: :data:`BENCH_SETUP`, then
     ``config_overrides`` (other fields)."""
-    from tuning._tune import TuneConfig, check_creature
+    from footfall.tuning._tune import TuneConfig, check_creature
 
     seed = _check_int("seed", seed, 0)
     rounds = _check_int("rounds", rounds, 1)
@@ -131,7 +131,7 @@ def run_proxy(config, workdir: str | Path, progress=None) -> dict:
     """
     import json
 
-    from tuning._tune import checkpoint_path, tune
+    from footfall.tuning._tune import checkpoint_path, tune
 
     out = Path(workdir) / f"bench-{config.creature}.json"
     marks: list[tuple[str, float]] = []
@@ -157,9 +157,9 @@ def search_space(start=None):
     """(x0, lower, upper): x = log weights (19) + log FITTED_TIMING fields (4), x0 = log of the default
     weights and of ``start`` (a ``GaitTiming``; None: the defaults). Upper bounds keep
     ``duty_at_rest`` < 1 and ``stride_exponent`` < 0.5 (their open ranges)."""
-    from planner._timing import GaitTiming
-    from planner._weights import ScoringWeights
-    from tuning._fit import FITTED_TIMING
+    from footfall.planner._timing import GaitTiming
+    from footfall.planner._weights import ScoringWeights
+    from footfall.tuning._fit import FITTED_TIMING
 
     timing = start or GaitTiming()
     x0 = np.log(np.concatenate([ScoringWeights().to_array(), [getattr(timing, n) for n in FITTED_TIMING]]))
@@ -173,9 +173,9 @@ def search_space(start=None):
 def decode(x, start=None):
     """(ScoringWeights, GaitTiming) of a point x of :func:`search_space` (the timing fields not searched
     are those of ``start``, None: the defaults); raises ValueError if invalid."""
-    from planner._timing import TIMING_FIELDS, GaitTiming
-    from planner._weights import ScoringWeights
-    from tuning._fit import FITTED_TIMING
+    from footfall.planner._timing import TIMING_FIELDS, GaitTiming
+    from footfall.planner._weights import ScoringWeights
+    from footfall.tuning._fit import FITTED_TIMING
 
     x = np.asarray(x, dtype=np.float64)
     n_w = len(ScoringWeights().to_array())
@@ -191,7 +191,7 @@ def decode(x, start=None):
 def exact_loss_of(setup, targets, x, start=None) -> tuple[float, str | None]:
     """The exact loss at x, or (:data:`INVALID_LOSS`, why) if x is not valid parameters or the
     exact run fails (one exact-planner evaluation either way)."""
-    from tuning._exact import exact_metrics
+    from footfall.tuning._exact import exact_metrics
 
     try:
         weights, timing = decode(x, start)
@@ -275,7 +275,7 @@ def run_cmaes(setup, targets, target_loss: float, max_evals: int, seed: int, sig
 
 def _warm_up(setup, targets, start) -> None:
     """One untimed, uncounted exact evaluation (numba caches, rasters) before either clock starts."""
-    from tuning._exact import exact_metrics
+    from footfall.tuning._exact import exact_metrics
 
     exact_metrics(setup, timing=start, targets=targets)
 
@@ -288,8 +288,8 @@ def run(creature: str = "spider", seed: int = 0, max_evals: int = DEFAULT_MAX_EV
     fields (e.g. a smaller exact setup for tests); ``workdir``: where the tune writes (default a
     temporary directory, removed afterwards).
     """
-    from tuning._config import enable_x64
-    from tuning._targets import load_targets
+    from footfall.tuning._config import enable_x64
+    from footfall.tuning._targets import load_targets
 
     max_evals = _check_int("max_evals", max_evals, 1)
     config = make_config(creature, seed=seed, rounds=rounds, config_overrides=config_overrides)
@@ -360,11 +360,11 @@ def run_events(creature: str, scenarios, seed: int = 0, max_evals: int = DEFAULT
 
     The tune's acceptance guards stay on (collisions, noise): the comparison is to the loss of the
     preset the tune writes. One untimed evaluation of the defaults warms the planner first."""
-    from planner._weights import ScoringWeights
-    from tuning._config import enable_x64
-    from tuning._events import event_metrics
-    from tuning._targets import load_tune_targets
-    from tuning._tune_events import EventTuneConfig, checkpoint_path, tune_events
+    from footfall.planner._weights import ScoringWeights
+    from footfall.tuning._config import enable_x64
+    from footfall.tuning._events import event_metrics
+    from footfall.tuning._targets import load_tune_targets
+    from footfall.tuning._tune_events import EventTuneConfig, checkpoint_path, tune_events
 
     import json
 

@@ -1,4 +1,16 @@
-"""footfall: procedural locomotion of multi-legged characters (Abdul Karim et al., CAVW 2012)."""
+"""footfall: procedural locomotion of multi-legged characters (Abdul Karim et al., CAVW 2012).
+
+One namespace, by floor (each imports only the ones before it; nothing imports the command line):
+
+* ``footfall`` (this package, the ground floor): :class:`InputError`, atomic writes
+  (``footfall._atomic``), running tasks in-process or on Dask workers (``footfall._distribute``),
+  the version. It imports nothing else of the project.
+* ``footfall.planner``: the exact discrete runtime (numpy + numba; never JAX, pyvista or pxr).
+* ``footfall.scenarios``: terrains, obstacles, creatures, gaits, crowds.
+* ``footfall.tuning``: the JAX scoring, the proxies, the fits and the presets.
+* ``footfall.benchmarks``, ``footfall.reports``: measurements, evaluation, pictures, USD.
+* ``footfall.cli``: the ``footfall`` command.
+"""
 
 from importlib.metadata import PackageNotFoundError, version
 

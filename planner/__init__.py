@@ -4,14 +4,14 @@ footprint scoring and the best footprint-trajectory couple search.
 numpy + numba only: this package never imports JAX, pyvista or pxr.
 """
 
-from planner._cache import configure_numba_cache as _configure_numba_cache
-from planner._threads import configure_worker_wait as _configure_worker_wait
+from footfall.planner._cache import configure_numba_cache as _configure_numba_cache
+from footfall.planner._threads import configure_worker_wait as _configure_worker_wait
 
 _configure_numba_cache()
 _configure_worker_wait()
 
-from planner._batch import BatchResult, FootBatch, make_batch, plan_batch  # noqa: E402
-from planner._crowd import (  # noqa: E402
+from footfall.planner._batch import BatchResult, FootBatch, make_batch, plan_batch  # noqa: E402
+from footfall.planner._crowd import (  # noqa: E402
     ControllerConfig,
     CrowdModel,
     CrowdState,
@@ -22,22 +22,31 @@ from planner._crowd import (  # noqa: E402
     step,
     sustained_speed,
 )
-from planner._gait import GaitManagerState, advance, init_gaits, set_destination, set_speed  # noqa: E402
-from planner._grid import GridFrame  # noqa: E402
-from planner._harvest import FEATURES, FootHarvest, Harvest, harvest_foot, harvest_situations, task_mapper  # noqa: E402
-from planner._ik import IKResult, body_rotation, legs_of, rest_pose_angles, solve_legs  # noqa: E402
-from planner._lod import FULL_SEARCH, LOD_MODES, LodConfig  # noqa: E402
-from planner._maps import LocalMaps, WorldRaster  # noqa: E402
-from planner._params import (  # noqa: E402
+from footfall.planner._gait import GaitManagerState, advance, init_gaits, set_destination, set_speed  # noqa: E402
+from footfall.planner._grid import GridFrame  # noqa: E402
+from footfall.planner._harvest import (  # noqa: E402
+    FEATURES,
+    FootHarvest,
+    Harvest,
+    harvest_foot,
+    harvest_run,
+    merge_harvest_chunks,
+    pack_harvest,
+    task_mapper,
+)
+from footfall.planner._ik import IKResult, body_rotation, legs_of, rest_pose_angles, solve_legs  # noqa: E402
+from footfall.planner._lod import FULL_SEARCH, LOD_MODES, LodConfig  # noqa: E402
+from footfall.planner._maps import LocalMaps, WorldRaster  # noqa: E402
+from footfall.planner._params import (  # noqa: E402
     DEFAULT_BUDGET,
     EXHAUSTIVE,
     FIRST_VALID,
     PlannerConfig,
     SearchBudget,
 )
-from planner._presets import PRESET_SCHEMA_VERSION, Preset, load_preset, preset_dict  # noqa: E402
-from planner._search import COUNTERS, RAW_METRICS, CoupleResult, FootQuery, plan_foot, wavefront_distances  # noqa: E402
-from planner._simulation import (  # noqa: E402
+from footfall.planner._presets import PRESET_SCHEMA_VERSION, Preset, load_preset, preset_dict  # noqa: E402
+from footfall.planner._search import COUNTERS, RAW_METRICS, CoupleResult, FootQuery, plan_foot, wavefront_distances  # noqa: E402
+from footfall.planner._simulation import (  # noqa: E402
     RECORDING_VERSION,
     Recorder,
     SimulationSummary,
@@ -46,8 +55,8 @@ from planner._simulation import (  # noqa: E402
     realised_strides,
     simulate,
 )
-from planner._threads import single_threaded  # noqa: E402
-from planner._timing import (  # noqa: E402
+from footfall.planner._threads import single_threaded  # noqa: E402
+from footfall.planner._timing import (  # noqa: E402
     GRAVITY,
     SWING_MAX,
     SWING_MIN,
@@ -60,7 +69,7 @@ from planner._timing import (  # noqa: E402
     stride_law,
     stride_length,
 )
-from planner._weights import (  # noqa: E402
+from footfall.planner._weights import (  # noqa: E402
     FOOTPRINT_TERMS,
     SCORE_TERMS,
     TRAJECTORY_TERMS,
@@ -70,7 +79,7 @@ from planner._weights import (  # noqa: E402
     rational_goodness,
     rising_goodness,
 )
-from planner import layout  # noqa: E402  (the packed arrays' names and indices)
+from footfall.planner import layout  # noqa: E402  (the packed arrays' names and indices)
 
 __all__ = [
     "COUNTERS",
@@ -112,7 +121,7 @@ __all__ = [
     "GridFrame",
     "Harvest",
     "harvest_foot",
-    "harvest_situations",
+    "harvest_run",
     "hip_height",
     "IKResult",
     "init_crowd",
@@ -148,6 +157,8 @@ __all__ = [
     "stride_law",
     "stride_length",
     "sustained_speed",
+    "merge_harvest_chunks",
+    "pack_harvest",
     "task_mapper",
     "wavefront_distances",
     "WorldRaster",

@@ -6,12 +6,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planner._kernels_batch import FootRequests, FootResults, plan_feet_parallel, plan_feet_serial
-from planner._kernels_foot import N_COUNTERS, N_RAW
-from planner._maps import LocalMaps
-from planner._params import DEFAULT_BUDGET, PlannerConfig, SearchBudget
-from planner._search import MODES, FootQuery
-from planner._weights import N_TERMS, ScoringWeights
+from footfall.planner._kernels_batch import FootRequests, FootResults, plan_feet_parallel, plan_feet_serial
+from footfall.planner._kernels_foot import N_COUNTERS, N_RAW
+from footfall.planner._maps import LocalMaps
+from footfall.planner._params import DEFAULT_BUDGET, PlannerConfig, SearchBudget
+from footfall.planner._search import MODES, FootQuery
+from footfall.planner._weights import N_TERMS, ScoringWeights
 
 
 @dataclass(frozen=True)

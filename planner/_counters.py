@@ -29,8 +29,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from planner._ik import DEFAULT_TOLERANCE
-from planner._kernels_controller import (
+from footfall.planner._ik import DEFAULT_TOLERANCE
+from footfall.planner._kernels_controller import (
     count_body_overlaps,
     count_close_pairs,
     count_collisions,
@@ -51,9 +51,9 @@ def rendered_joints(model, state, hips=None) -> np.ndarray:
     """(C, L, S + 2, 3) joint positions as drawn: forward kinematics of the IK angles, the hip
     first and the foot last; for characters whose IK is off, a straight hip -> planned foot leg.
     ``hips``: the state's (C, L, 3) hips (:func:`planner._crowd.hips_world`) if the caller has them."""
-    from planner._crowd import hips_world
-    from planner._ik import body_rotation
-    from planner._kernels_ik import forward_kinematics_batch
+    from footfall.planner._crowd import hips_world
+    from footfall.planner._ik import body_rotation
+    from footfall.planner._kernels_ik import forward_kinematics_batch
 
     c, l = state.in_stance.shape
     legs = model.leg_static
@@ -157,7 +157,7 @@ class FrameCounters:
         self._trail[slot] = state.pelvis[:, [0, 2]]
         self._frames += 1
         if self._frames >= window:
-            from planner._simulation import arrived
+            from footfall.planner._simulation import arrived
 
             asked = STUCK_FRACTION * state.desired_speed * STUCK_WINDOW_S
             self.stuck_frames += int(((since < asked) & ~arrived(model, state)).sum())

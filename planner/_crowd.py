@@ -37,10 +37,10 @@ from functools import cached_property
 
 import numpy as np
 
-from planner._batch import FootBatch, plan_batch
-from planner._kernels_body import pelvis_from_hulls
-from planner._counters import rendered_joints
-from planner._kernels_controller import (
+from footfall.planner._batch import FootBatch, plan_batch
+from footfall.planner._kernels_body import pelvis_from_hulls
+from footfall.planner._counters import rendered_joints
+from footfall.planner._kernels_controller import (
     advance_swings,
     count_forbidden_landings,
     legs_crossed_by_turn,
@@ -50,8 +50,8 @@ from planner._kernels_controller import (
     swings_invalidated,
     uncrossed_turns,
 )
-from planner._kernels_maps import build_local_maps
-from planner._lod import (
+from footfall.planner._kernels_maps import build_local_maps
+from footfall.planner._lod import (
     FULL_SEARCH,
     LEVEL_FAR,
     LEVEL_FULL,
@@ -62,9 +62,9 @@ from planner._lod import (
     lod_levels,
     visibility,
 )
-from planner._maps import WorldRaster
-from planner._params import PlannerConfig, SearchBudget
-from planner._weights import ScoringWeights
+from footfall.planner._maps import WorldRaster
+from footfall.planner._params import PlannerConfig, SearchBudget
+from footfall.planner._weights import ScoringWeights
 
 DT = 1.0 / 30.0
 ESCAPE_FROUDE = 0.5
@@ -188,7 +188,7 @@ class CrowdModel:
     @property
     def leg_height(self) -> float:
         """h of the Froude number: the mean hip height when standing, m."""
-        from planner._timing import hip_height
+        from footfall.planner._timing import hip_height
 
         return hip_height(self.creature)
 
@@ -259,7 +259,7 @@ class CrowdState:
 def hips_world(model: CrowdModel, state: CrowdState) -> np.ndarray:
     """(C, L, 3) hip positions: body-frame hips rotated by heading, pitch and roll
     (the rotation of :func:`planner._ik.body_rotation`)."""
-    from planner._ik import body_rotation
+    from footfall.planner._ik import body_rotation
 
     rotation = body_rotation(state.heading, state.pitch, state.roll)[:, None]  # (C, 1, 3, 3): forward, up, left
     h = model.hips_body[None, :, None, :]  # (1, L, 1, 3)
@@ -494,7 +494,7 @@ def _lane_exit(model: CrowdModel, state: CrowdState, direction: np.ndarray, boxe
     # The box and the character close in at the box's speed plus the character's own toward it; the
     # nearer side, and a character dead centre takes the side its way leans to (a way with no part
     # across the lane: the side of -side_axis, a fixed convention so that the choice is deterministic).
-    from planner._kernels_lanes import lane_threats
+    from footfall.planner._kernels_lanes import lane_threats
 
     n_boxes = moving.size
     threat = np.empty((n, n_boxes), np.bool_)
@@ -563,7 +563,7 @@ def _avoid(model: CrowdModel, state: CrowdState, preferred: np.ndarray, to_targe
     within :data:`NEAR_RADII` avoid radii (among neighbours). ``boxes`` as
     :func:`_boxes_now` gives them, ``box_velocity`` from :func:`_box_velocities`; ``escaping`` (C,)
     bool: characters leaving a moving box's lane, whom their neighbours make way for."""
-    from planner._kernels_avoidance import neighbour_lists, orca_velocities
+    from footfall.planner._kernels_avoidance import neighbour_lists, orca_velocities
 
     n = state.pelvis.shape[0]
     xz = np.ascontiguousarray(state.pelvis[:, [0, 2]])
@@ -607,7 +607,7 @@ def _avoid(model: CrowdModel, state: CrowdState, preferred: np.ndarray, to_targe
 
 def stance_room(model: CrowdModel, state: CrowdState) -> np.ndarray:
     """(C, L) m: how far each foot is in front of the rear end of its leg's stance window."""
-    from planner._ik import body_rotation
+    from footfall.planner._ik import body_rotation
 
     # Measured along the body's forward axis (the window's own frame): on a slope the body pitches.
     axis = body_rotation(state.heading, state.pitch, state.roll)[:, :, 0]  # (C, 3)
@@ -624,7 +624,7 @@ def stance_speed_cap(model: CrowdModel, state: CrowdState) -> np.ndarray:
 def resume_frequency(model: CrowdModel, state: CrowdState) -> np.ndarray:
     """(C,) Hz: the stride frequency of the walk each character heads for (its goal speed, within its
     speed limit): the tempo of a body that stands, or speeds up, once it walks."""
-    from planner._timing import _stride_frequency
+    from footfall.planner._timing import _stride_frequency
 
     # Three calls a frame: the checks of the public stride_frequency cost as much as the formula.
     return _stride_frequency(model.timing, sustained_speed(state), model.leg_height)
@@ -717,9 +717,9 @@ def turn_crossed_legs(model: CrowdModel, state: CrowdState, turn) -> np.ndarray:
 def stage_gait(model: CrowdModel, state: CrowdState):
     """Stride frequency and duty factor from the speed (the destination disks follow the
     duty factor, the disks in use move toward them while in stance), then the needle."""
-    from planner._gait import advance, set_destination, set_speed
-    from planner._timing import GRAVITY, stride_length
-    from planner._workspace import duty_ceiling
+    from footfall.planner._gait import advance, set_destination, set_speed
+    from footfall.planner._timing import GRAVITY, stride_length
+    from footfall.planner._workspace import duty_ceiling
 
     # Gait changes with speed (planner._gait_schedule): the new gait's disks are the destination.
     # The gait follows the speed the character heads for (its goal), not the speed of the moment:
@@ -844,7 +844,7 @@ def _with_neighbours_feet(model: CrowdModel, state: CrowdState, cs, own, preferr
     n_chars, n_legs = state.in_stance.shape
     if not model.controller.avoid_others_feet or n_chars < 2 or f == 0:
         return np.ascontiguousarray(own.reshape(-1, 4)), np.arange(f + 1, dtype=np.int64) * k
-    from planner._kernels_geometry import points_near
+    from footfall.planner._kernels_geometry import points_near
 
     support = np.ascontiguousarray(support[..., [0, 2]].reshape(-1, 2))
     owner = np.repeat(np.arange(n_chars), n_legs)
@@ -871,7 +871,7 @@ def _solve_feet(model: CrowdModel, state: CrowdState, cs, ls, hips, iterations: 
     """CCD (or, with ``two_bone``, the closed-form solve of far characters) for legs (cs, ls)
     reaching for their feet from ``hips``, warm-started from the current angles (the one IK call
     of the controller's look-ahead and IK stages)."""
-    from planner._ik import solve_legs_trusted
+    from footfall.planner._ik import solve_legs_trusted
 
     legs = model.leg_static
     state.counters["ik_two_bone_legs" if two_bone else "ik_ccd_legs"] += int(cs.size)
@@ -1123,7 +1123,7 @@ def _stamp_others(model: CrowdModel, state: CrowdState, chars: np.ndarray, forb,
     """Other characters' bodies and stance feet into the planning characters' obstacles' maps."""
     from scipy.spatial import cKDTree
 
-    from planner._kernels_maps import stamp_other_characters
+    from footfall.planner._kernels_maps import stamp_other_characters
 
     n = state.pelvis.shape[0]
     if n < 2:
@@ -1190,7 +1190,7 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     spacing = state.feet_spacing[cs]
     # The stance sweep v * T_stance is centred inside the leg's stance window (planner._workspace):
     # a leg whose rest foot sits near an end of its window would run out of reach before lift-off.
-    from planner._workspace import slope_scale, stance_centres
+    from footfall.planner._workspace import slope_scale, stance_centres
 
     sweep = travel(v, goal, model.controller.acceleration, t_swing + t_stance) - travel_swing
     # No stance carries a foot further than its leg's window (stance_speed_cap steps it at the rear
@@ -1431,7 +1431,7 @@ def _take_requests(request: FootBatch, rows: np.ndarray) -> FootBatch:
 
 def _merge_results(parts, n: int):
     """One BatchResult of ``n`` requests from [(rows, BatchResult of those rows)]."""
-    from planner._batch import BatchResult
+    from footfall.planner._batch import BatchResult
 
     first = parts[0][1]
     merged = BatchResult(**{name: np.zeros((n,) + getattr(first, name).shape[1:], getattr(first, name).dtype)
@@ -1552,8 +1552,8 @@ def _take_back_crossing_poses(model: CrowdModel, state: CrowdState, stance_befor
     straight hip-to-foot lines of the pose before the move; the legs as drawn, with their knees, after
     the move and the tilt, crossed on turns on the spot (crates-moving, 12 spiders, seed 3).
     ``stance_before``: the stance feet at the start of the frame. Keeps ``state.crossed``."""
-    from planner._counters import rendered_joints
-    from planner._kernels_controller import crossing_pairs
+    from footfall.planner._counters import rendered_joints
+    from footfall.planner._kernels_controller import crossing_pairs
 
     # Only pairs of stance legs: a pair stands through the next frame only if both stand now.
     n, L = state.in_stance.shape
@@ -1605,7 +1605,7 @@ def crowd_radius(creature, rest_radius: float | None = None) -> float:
 
     Examples
     --------
-    >>> from scenarios import load_creature
+    >>> from footfall.scenarios import load_creature
     >>> spider, dog = load_creature("spider"), load_creature("quadruped")
     >>> crowd_radius(spider) == float(spider.rest_radius)
     True
@@ -1621,7 +1621,7 @@ def avoid_radius(creature, rest_radius: float | None, positions: np.ndarray) -> 
     radius, or half the least spacing they were spawned at (a crowd spawned denser), at least
     :data:`AVOID_RADIUS_MIN` x it (the body).
 
-    >>> from scenarios import load_creature
+    >>> from footfall.scenarios import load_creature
     >>> spider = load_creature("spider")
     >>> r = crowd_radius(spider)
     >>> avoid_radius(spider, None, np.array([[0.0, 0.0], [3.0 * r, 0.0]])) == r
@@ -1707,9 +1707,9 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
     (only with ``lod_mode='off'``: the LOD modes set their own budgets).
     """
     from footfall._errors import InputError
-    from planner._gait import init_gaits
-    from planner._ik import legs_of, rest_pose_angles
-    from planner._timing import GaitTiming
+    from footfall.planner._gait import init_gaits
+    from footfall.planner._ik import legs_of, rest_pose_angles
+    from footfall.planner._timing import GaitTiming
 
     if lod_mode not in ("on", "zoomed", "off"):
         raise InputError("argument", "--lod", f"expected on, zoomed or off, got {lod_mode!r}")
@@ -1736,7 +1736,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
     rest_body = spacing * np.asarray(creature.rest_feet, dtype=np.float64)
     leg_static = legs_of(creature)
     # A safe box taller than the creature can step onto is forbidden for it (it walks around).
-    from planner._workspace import highest_step
+    from footfall.planner._workspace import highest_step
 
     highest = highest_step(creature, rest_body, hips_body, leg_static)
     obstacles = _too_tall_forbidden(scenario.obstacles, highest)
@@ -1750,9 +1750,9 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         raster = WorldRaster.build(scenario.terrain, obstacles, config.cell_size)
     if abs(raster.frame.cell_size - config.cell_size) > 1e-12:
         raise ValueError(f"raster: cell size {raster.frame.cell_size} differs from the planner's {config.cell_size}")
-    from planner._gait_schedule import as_schedule
-    from planner._timing import GRAVITY, hip_height
-    from planner._workspace import height_ranges, speed_cap, stance_windows
+    from footfall.planner._gait_schedule import as_schedule
+    from footfall.planner._timing import GRAVITY, hip_height
+    from footfall.planner._workspace import height_ranges, speed_cap, stance_windows
 
     schedule = as_schedule(gait)
     window = stance_windows(creature, rest_body, hips_body, leg_static)
@@ -1763,7 +1763,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
     escape = min(cap, math.sqrt(ESCAPE_FROUDE * GRAVITY * hip_height(creature)))
     far_first, far_fallback = None, None
     if lod_mode != "off":
-        from planner._far_planning import far_configs
+        from footfall.planner._far_planning import far_configs
 
         far_first, far_fallback = far_configs(config, span, lod.far_radius_cells, lod.far_margin_cells,
                                               lod.far_fallback_margin_cells)

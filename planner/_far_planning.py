@@ -33,7 +33,7 @@ from __future__ import annotations
 import dataclasses
 import math
 
-from planner._params import PlannerConfig
+from footfall.planner._params import PlannerConfig
 
 
 def compact_map_cells(config: PlannerConfig, span_m: float) -> int:

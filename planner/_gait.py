@@ -34,8 +34,8 @@ from typing import Any
 
 import numpy as np
 
-from planner._kernels_gait import active_feet, advance_gaits, retime_gaits
-from planner._timing import GaitTiming, scaled_swing_durations
+from footfall.planner._kernels_gait import active_feet, advance_gaits, retime_gaits
+from footfall.planner._timing import GaitTiming, scaled_swing_durations
 
 DEFAULT_TRANSITION_RATE = 0.5
 """Cycles of phase per second a disk's start moves during a gait transition (a half-cycle shift in 1 s)."""

@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from planner._timing import GRAVITY
+from footfall.planner._timing import GRAVITY
 
 HYSTERESIS = 0.8
 """A character moves back down a gait below this fraction of the Froude number it moved up at."""

@@ -9,12 +9,14 @@ own goodness and scoring functions, so the runtime's scores are stored alongside
 (tuning/ recomputes them from the raw numbers and must find the same values).
 
 * :func:`harvest_foot`: one foot (``LocalMaps`` + ``FootQuery``), validated.
-* :func:`harvest_situations`: short seeded crowd runs (``init_crowd`` / ``step``)
-  over built-in scenarios and creatures; every planning request of every frame
-  becomes a situation. Struct-of-arrays, padded to the largest candidate and
-  slice counts, with masks. Deterministic for a seed. Each (creature, scenario, seed)
-  run is an independent task (:func:`harvest_chunk`), so a caller may hand them to
-  worker processes (``map_tasks``); planner/ itself never imports Dask.
+* :func:`harvest_run`: one short seeded crowd run (``init_crowd`` / ``step``) of a
+  loaded scenario, creature and gait; every planning request of every frame becomes
+  a row. :func:`merge_harvest_chunks` and :func:`pack_harvest` make the rows of several
+  runs one :class:`Harvest`: struct-of-arrays, padded to the largest candidate and
+  slice counts, with masks. Deterministic for a seed. The runs by name, as tasks a
+  caller may hand to worker processes, are the tuning's
+  (``footfall.tuning.harvest_situations``); planner/ itself never imports Dask, nor
+  the scenarios.
 """
 
 from __future__ import annotations
@@ -24,14 +26,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planner._kernels_geometry import foot_offsets
-from planner._kernels_search import MODE_SEARCH, harvest_foot_kernel, plan_foot_kernel
-from planner._maps import LocalMaps
-from planner._params import DEFAULT_BUDGET, PlannerConfig, SearchBudget
-from planner._search import FootQuery, checked_foot_offsets
-from planner._threads import single_threaded
-from planner._weights import N_FOOTPRINT_TERMS, N_TERMS, ScoringWeights
-from planner.layout import FEATURES, N_FEATURES, N_RAW  # FEATURES: the order of ``cand_features``
+from footfall.planner._kernels_geometry import foot_offsets
+from footfall.planner._kernels_search import MODE_SEARCH, harvest_foot_kernel, plan_foot_kernel
+from footfall.planner._maps import LocalMaps
+from footfall.planner._params import DEFAULT_BUDGET, PlannerConfig, SearchBudget
+from footfall.planner._search import FootQuery, checked_foot_offsets
+from footfall.planner._threads import single_threaded
+from footfall.planner._weights import N_FOOTPRINT_TERMS, N_TERMS, ScoringWeights
+from footfall.planner.layout import FEATURES, N_FEATURES, N_RAW  # FEATURES: the order of ``cand_features``
 
 
 
@@ -173,7 +175,10 @@ def _harvest_batch(batch, weights, config, out, cs, ls, kinds, state, model, met
             crowd_choice=crowd))
 
 
-def _pack(rows: list[dict], creatures, scenarios, weights: np.ndarray, timing: np.ndarray) -> Harvest:
+def pack_harvest(rows: list[dict], creatures, scenarios, weights: np.ndarray, timing: np.ndarray) -> Harvest:
+    """The rows of :func:`harvest_run` (merged by :func:`merge_harvest_chunks`) as one :class:`Harvest`:
+    ``creatures`` and ``scenarios`` name the rows' indices; ``weights`` and ``timing`` are the packed
+    parameters the runs used."""
     f = len(rows)
     k = max([r["foot"].cand_scores.size for r in rows] + [1])
     s = max([r["foot"].levels.size for r in rows] + [1])
@@ -222,48 +227,10 @@ def _pack(rows: list[dict], creatures, scenarios, weights: np.ndarray, timing: n
         crowd_choice=col("crowd_choice", np.int64).reshape(f, 2), weights=weights, timing=timing)
 
 
-def harvest_situations(scenarios=("mixed",), creatures=("spider",), *, seeds=(0,), frames: int = 30,
-                       n_characters: int = 2, weights: ScoringWeights | None = None, timing=None,
-                       max_situations: int | None = None, map_tasks=None) -> Harvest:
-    """Run ``frames`` frames of a seeded crowd (LOD off: the paper's full search) per scenario,
-    creature and seed, and harvest every planning request (module docstring).
-
-    Creatures use their default gait. Stops once ``max_situations`` situations are
-    collected (whole frames: the last frame's requests are all kept).
-
-    The runs are independent chunks, one per (creature, scenario, seed) (:func:`harvest_tasks`,
-    :func:`harvest_chunk`). ``map_tasks(function, tasks) -> list`` (results in task order, e.g.
-    from ``footfall._distribute.task_runner``) runs them, on workers or not; None runs them here,
-    one after the other. The result is the same, bit for bit, either way.
-    """
-    from planner._timing import GaitTiming
-
-    if isinstance(scenarios, str) or isinstance(creatures, str):
-        raise ValueError("scenarios, creatures: expected sequences of names")
-    if not scenarios or not creatures or not seeds:
-        raise ValueError("scenarios, creatures, seeds: expected at least one of each")
-    if isinstance(frames, bool) or not isinstance(frames, int) or frames < 1:
-        raise ValueError(f"frames: expected an integer >= 1, got {frames!r}")
-    if isinstance(n_characters, bool) or not isinstance(n_characters, int) or n_characters < 1:
-        raise ValueError(f"n_characters: expected an integer >= 1, got {n_characters!r}")
-    if max_situations is not None and (isinstance(max_situations, bool) or not isinstance(max_situations, int)
-                                       or max_situations < 1):
-        raise ValueError(f"max_situations: expected None or an integer >= 1, got {max_situations!r}")
-    run = task_mapper(map_tasks)
-    weights = weights or ScoringWeights()
-    timing = timing or GaitTiming()
-    tasks = harvest_tasks(scenarios, creatures, seeds, frames, n_characters, weights, timing, max_situations)
-    # In this process the chunks run lazily: once the cap is reached the rest never run. With a
-    # map_tasks every chunk runs (in parallel) and those past the cap are dropped by the merge.
-    chunks = run(harvest_chunk, tasks)
-    rows = _merge_chunks(chunks, max_situations)
-    return _pack(rows, creatures, scenarios, weights.to_array(), timing.to_array())
-
-
 def task_mapper(map_tasks=None):
     """``map_tasks`` checked, or (``None``) a lazy in-process map: ``run(function, tasks)`` gives the
-    results in task order. One check for every caller that takes a ``map_tasks`` (harvests here,
-    the tune's exact runs)."""
+    results in task order. One check for every caller that takes a ``map_tasks`` (the tuning's
+    harvests and exact runs)."""
     if map_tasks is None:
         return map
     if not callable(map_tasks):
@@ -271,69 +238,46 @@ def task_mapper(map_tasks=None):
     return map_tasks
 
 
-def harvest_tasks(scenarios, creatures, seeds, frames: int, n_characters: int, weights: ScoringWeights, timing,
-                  max_situations: int | None) -> list[dict]:
-    """One plain-dict task per (creature, scenario, seed), in the order the situations are packed.
-
-    A task carries every input of its run (names, their indices in the harvest, parameters as
-    lists of floats), so it gives the same rows wherever it runs. Its cap is the global one: a
-    chunk never contributes more than ``max_situations`` rows (plus the rest of its last frame).
-    """
-    w = [float(x) for x in weights.to_array()]
-    t = [float(x) for x in timing.to_array()]
-    return [{"creature": str(creature_name), "creature_index": ci, "scenario": str(scenario_name),
-             "scenario_index": si, "seed": int(seed), "frames": int(frames), "n_characters": int(n_characters),
-             "weights": w, "timing": t, "max_situations": max_situations}
-            for ci, creature_name in enumerate(creatures)
-            for si, scenario_name in enumerate(scenarios)
-            for seed in seeds]
-
-
-def harvest_chunk(task: dict) -> dict:
-    """Run one task of :func:`harvest_tasks`: ``{"rows": [...], "frame_ends": [...]}``, the situations
-    of its crowd run in order and the row count after each harvested frame (where a global cap may cut).
+def harvest_run(scenario, creature, gait, *, weights: ScoringWeights, timing, n_characters: int, seed: int,
+                frames: int, max_situations: int | None = None, meta: dict | None = None) -> dict:
+    """Run ``frames`` frames of a seeded crowd (LOD off: the paper's full search) and harvest every
+    planning request: ``{"rows": [...], "frame_ends": [...]}``, the situations in order and the row
+    count after each harvested frame (where a global cap may cut; the run stops at the end of the
+    frame that reaches ``max_situations``). ``meta`` (a dict) is copied into every row.
 
     Rows hold numpy arrays and :class:`FootHarvest` records: picklable, for a worker to send back.
     """
-    from planner._crowd import init_crowd, planner_config_for, step
-    from planner._maps import WorldRaster
-    from planner._timing import GaitTiming
-    from scenarios import default_gait_name, load_creature, load_gait, load_scenario
+    from footfall.planner._crowd import init_crowd, planner_config_for, step
+    from footfall.planner._maps import WorldRaster
 
-    weights = ScoringWeights.from_array(task["weights"])
-    timing = GaitTiming.from_array(task["timing"])
-    cap = task["max_situations"]
+    meta = dict(meta or {})
     # A few characters plan a few feet per frame: fanning each small kernel call out over
     # the cores costs more than it saves (x20 on a busy 2-core machine), and the parallel
     # and serial kernels give identical results (tests/test_planner_properties.py). Set here,
-    # not by the caller, so a chunk run by any map_tasks gets it.
+    # not by the caller, so a run on any worker gets it.
     with single_threaded():
-        creature = load_creature(task["creature"])
-        gait = load_gait(default_gait_name(creature.name), creature)
         cell = planner_config_for(creature).cell_size
-        scenario = load_scenario(task["scenario"])
-        # Built per chunk (deterministic), not shared between the seeds of a scenario: a chunk
-        # depends on nothing but its task.
+        # Built per run (deterministic), not shared between the seeds of a scenario: a run
+        # depends on nothing but its arguments.
         raster = WorldRaster.build(scenario.terrain, scenario.obstacles, cell)
-        model, state = init_crowd(scenario, creature, gait, n_characters=task["n_characters"], seed=task["seed"],
+        model, state = init_crowd(scenario, creature, gait, n_characters=n_characters, seed=seed,
                                   weights=weights, timing=timing, lod_mode="off", raster=raster)
-        meta = {"creature": task["creature_index"], "scenario": task["scenario_index"], "seed": task["seed"]}
         rows: list[dict] = []
         frame_ends: list[int] = []
-        for _ in range(task["frames"]):
+        for _ in range(frames):
             plans = step(model, state).plans
             if plans is None:
                 continue
             _harvest_batch(plans.batch, model.weights, model.config, plans.result, plans.chars, plans.legs, plans.kinds,
                            state, model, meta, rows)
             frame_ends.append(len(rows))
-            # The global count is at least this chunk's, so the global cap never cuts later than here.
-            if cap is not None and len(rows) >= cap:
+            # The global count is at least this run's, so the global cap never cuts later than here.
+            if max_situations is not None and len(rows) >= max_situations:
                 break
     return {"rows": rows, "frame_ends": frame_ends}
 
 
-def _merge_chunks(chunks, max_situations: int | None) -> list[dict]:
+def merge_harvest_chunks(chunks, max_situations: int | None) -> list[dict]:
     """Concatenate the chunks' rows in task order, cut as the sequential loop cut: at the end of the
     first frame at which the running total reaches ``max_situations`` (whole frames; later chunks
     add nothing, and are not even pulled from a lazy ``chunks``)."""

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planner._kernels_ik import (
+from footfall.planner._kernels_ik import (
     forward_kinematics_batch,
     nearest_in_limits,
     solve_legs_parallel,

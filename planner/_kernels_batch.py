@@ -12,9 +12,9 @@ from collections import namedtuple
 import numba as nb
 import numpy as np
 
-from planner._kernels_geometry import foot_offsets
-from planner._kernels_search import plan_foot_kernel
-from planner._params import C_CELL
+from footfall.planner._kernels_geometry import foot_offsets
+from footfall.planner._kernels_search import plan_foot_kernel
+from footfall.planner._params import C_CELL
 
 FootRequests = namedtuple("FootRequests", [
     "elevation", "ground", "forbidden", "origins",  # the characters' stacked local maps (C, N, N), origins (C, 2)

@@ -7,7 +7,7 @@ import math
 import numba as nb
 import numpy as np
 
-from planner._kernels_geometry import rects_overlap, segments_cross
+from footfall.planner._kernels_geometry import rects_overlap, segments_cross
 
 
 @nb.njit(cache=True)

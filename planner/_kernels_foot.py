@@ -23,10 +23,10 @@ import math
 import numba as nb
 import numpy as np
 
-from planner._grid import cell_centre, cell_of
-from planner._kernels_geometry import segment_point_distance, segments_cross, supercover_visit
-from planner._kernels_wavefront import chamfer_distance
-from planner._weights import (
+from footfall.planner._grid import cell_centre, cell_of
+from footfall.planner._kernels_geometry import segment_point_distance, segments_cross, supercover_visit
+from footfall.planner._kernels_wavefront import chamfer_distance
+from footfall.planner._weights import (
     N_FOOTPRINT_TERMS,
     N_TERMS,
     W_CLEARANCE_REF,
@@ -44,7 +44,7 @@ from planner._weights import (
 )
 # The raw trajectory metrics (RAW_*), footprint features (FEAT_*) and counters (CNT_*), in the order of the
 # results: planner.layout.
-from planner.layout import (  # noqa: F401  (re-exported: the kernels' callers read them from here too)
+from footfall.planner.layout import (  # noqa: F401  (re-exported: the kernels' callers read them from here too)
     CNT_CANDIDATES,
     CNT_COUPLES_2D,
     CNT_COUPLES_3D,

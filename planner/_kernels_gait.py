@@ -43,7 +43,7 @@ import math
 
 import numba as nb
 
-from planner._timing import (
+from footfall.planner._timing import (
     GRAVITY,
     SWING_MAX,
     SWING_MIN,

@@ -13,7 +13,7 @@ import math
 import numba as nb
 import numpy as np
 
-from planner._kernels_geometry import rasterise_boxes, rect_overlaps_aabb
+from footfall.planner._kernels_geometry import rasterise_boxes, rect_overlaps_aabb
 
 
 @nb.njit(cache=True)

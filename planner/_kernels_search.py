@@ -43,8 +43,8 @@ from collections import namedtuple
 import numba as nb
 import numpy as np
 
-from planner._grid import cell_centre, cell_of
-from planner._kernels_foot import (
+from footfall.planner._grid import cell_centre, cell_of
+from footfall.planner._kernels_foot import (
     CNT_CANDIDATES,
     CNT_COUPLES_2D,
     CNT_COUPLES_3D,
@@ -71,10 +71,10 @@ from planner._kernels_foot import (
     trajectory_goodness,
     weighted_mean,
 )
-from planner._kernels_wavefront import wavefront
-from planner._params import C_CELL, C_MARGIN, C_OBST_MARGIN, C_POT_GAIN, C_POT_RANGE, C_RADIUS, C_SAMPLES, C_SLICE_EPS
-from planner._weights import N_FOOTPRINT_TERMS, N_TERMS
-from planner.layout import (  # noqa: F401  (the search modes and the scores' order: planner.layout)
+from footfall.planner._kernels_wavefront import wavefront
+from footfall.planner._params import C_CELL, C_MARGIN, C_OBST_MARGIN, C_POT_GAIN, C_POT_RANGE, C_RADIUS, C_SAMPLES, C_SLICE_EPS
+from footfall.planner._weights import N_FOOTPRINT_TERMS, N_TERMS
+from footfall.planner.layout import (  # noqa: F401  (the search modes and the scores' order: planner.layout)
     MODE_BRUTE_FORCE,
     MODE_PER_TARGET,
     MODE_SEARCH,

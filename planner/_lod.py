@@ -38,7 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planner._params import SearchBudget
+from footfall.planner._params import SearchBudget
 
 LOD_MODES = ("on", "zoomed", "off")
 LEVEL_FULL, LEVEL_FAR, LEVEL_HIDDEN = 0, 1, 2

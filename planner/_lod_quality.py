@@ -25,9 +25,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from planner._counters import CONTACT_TOLERANCE_M
-from planner._kernels_controller import count_body_overlaps, count_collisions
-from planner._lod import LEVEL_NAMES
+from footfall.planner._counters import CONTACT_TOLERANCE_M
+from footfall.planner._kernels_controller import count_body_overlaps, count_collisions
+from footfall.planner._lod import LEVEL_NAMES
 
 
 class LevelMeter:

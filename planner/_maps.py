@@ -17,8 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planner._grid import GridFrame
-from planner._kernels_geometry import rasterise_boxes
+from footfall.planner._grid import GridFrame
+from footfall.planner._kernels_geometry import rasterise_boxes
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:

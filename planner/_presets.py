@@ -25,7 +25,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from footfall._errors import InputError
-from planner._weights import WEIGHT_FIELDS, ScoringWeights
+from footfall.planner._weights import WEIGHT_FIELDS, ScoringWeights
 
 PRESET_SCHEMA_VERSION = 1
 _TOP_FIELDS = {"schema_version", "creature", "gait", "weights", "timing", "provenance"}
@@ -60,7 +60,7 @@ def _numbers(path, section: str, values, fields: tuple[str, ...]) -> dict[str, f
 
 def load_preset(path: str | Path, creature: str | None = None) -> Preset:
     """Read and validate a preset; with ``creature``, refuse a preset made for another one."""
-    from planner._timing import GaitTiming
+    from footfall.planner._timing import GaitTiming
 
     path = Path(path)
     try:

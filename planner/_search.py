@@ -7,13 +7,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from planner._kernels_geometry import foot_offsets
-from planner._kernels_search import MODE_BRUTE_FORCE, MODE_PER_TARGET, MODE_SEARCH, plan_foot_kernel
-from planner._kernels_wavefront import wavefront
-from planner._maps import LocalMaps
-from planner._params import DEFAULT_BUDGET, PlannerConfig, SearchBudget
-from planner._weights import SCORE_TERMS, ScoringWeights
-from planner.layout import COUNTERS, N_COUNTERS, N_RAW, RAW_METRICS, SCORE_COUPLE, SCORE_FOOTPRINT, SCORE_TRAJECTORY
+from footfall.planner._kernels_geometry import foot_offsets
+from footfall.planner._kernels_search import MODE_BRUTE_FORCE, MODE_PER_TARGET, MODE_SEARCH, plan_foot_kernel
+from footfall.planner._kernels_wavefront import wavefront
+from footfall.planner._maps import LocalMaps
+from footfall.planner._params import DEFAULT_BUDGET, PlannerConfig, SearchBudget
+from footfall.planner._weights import SCORE_TERMS, ScoringWeights
+from footfall.planner.layout import COUNTERS, N_COUNTERS, N_RAW, RAW_METRICS, SCORE_COUPLE, SCORE_FOOTPRINT, SCORE_TRAJECTORY
 
 MODES = {"search": MODE_SEARCH, "per_target": MODE_PER_TARGET, "brute_force": MODE_BRUTE_FORCE}
 

@@ -27,9 +27,9 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from footfall._atomic import atomic_path
-from planner._crowd import STAGES, CrowdModel, CrowdState, step
-from planner._counters import FrameCounters
-from planner._weights import N_TERMS
+from footfall.planner._crowd import STAGES, CrowdModel, CrowdState, step
+from footfall.planner._counters import FrameCounters
+from footfall.planner._weights import N_TERMS
 
 RECORDING_FORMAT = "footfall-recording"
 RECORDING_VERSION = 1
@@ -186,7 +186,7 @@ class StrideMeter:
         self.levels: list[np.ndarray] = []  # the LOD level of each measured stride's character at its landing
 
     def update(self, k: int, state: CrowdState, landed: np.ndarray) -> None:
-        from planner._timing import stride_frequency
+        from footfall.planner._timing import stride_frequency
 
         if not landed.any():
             return
@@ -259,7 +259,7 @@ def simulate(model: CrowdModel, state: CrowdState, frames: int, recorder: Record
     strides = StrideMeter(model, state)
     levels = None
     if model.lod_mode != "off":
-        from planner._lod_quality import LevelMeter
+        from footfall.planner._lod_quality import LevelMeter
 
         levels = LevelMeter(model, state)
     n_chars = state.pelvis.shape[0]

@@ -16,10 +16,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planner._kernels_geometry import foot_offsets
-from planner._maps import LocalMaps, WorldRaster
-from planner._params import PlannerConfig
-from planner._search import FootQuery
+from footfall.planner._kernels_geometry import foot_offsets
+from footfall.planner._maps import LocalMaps, WorldRaster
+from footfall.planner._params import PlannerConfig
+from footfall.planner._search import FootQuery
 
 
 def body_to_world_xz(x: float, z: float, heading: float, forward, lateral):

@@ -46,7 +46,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba.extending import register_jitable
 
-from planner._flat import FlatParameters
+from footfall.planner._flat import FlatParameters
 
 GRAVITY = 9.81
 """g, m/s^2."""

@@ -37,7 +37,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba.extending import register_jitable
 
-from planner._flat import FlatParameters
+from footfall.planner._flat import FlatParameters
 
 
 def _w(doc: str, default: float, *, unit: str = "-", scale: bool = False):

@@ -29,7 +29,7 @@ import math
 
 import numpy as np
 
-from planner._timing import GRAVITY
+from footfall.planner._timing import GRAVITY
 
 WINDOW_MARGIN = 0.08
 """Fraction of a stance window's length given up at each end."""
@@ -88,7 +88,7 @@ def stance_windows(creature, rest_body: np.ndarray, hips_body: np.ndarray, legs)
 def _reached(hips_body, legs, leg, targets) -> np.ndarray:
     """(n,) bool: the IK of leg ``leg[i]`` (joint limits included; level body, body frame) puts its
     foot on ``targets[i]`` (within :data:`REACH_TOLERANCE`)."""
-    from planner._ik import solve_legs
+    from footfall.planner._ik import solve_legs
 
     result = solve_legs(hips_body[leg], np.broadcast_to(np.eye(3), (leg.size, 3, 3)), legs.rest_azimuths[leg],
                         legs.segment_lengths[leg], legs.limits[leg], legs.azimuth_limits[leg], targets,
@@ -183,7 +183,7 @@ def speed_cap(timing, leg_height: float, window: float) -> float:
 
     Examples
     --------
-    >>> from planner._timing import GaitTiming
+    >>> from footfall.planner._timing import GaitTiming
     >>> v = speed_cap(GaitTiming(), 0.42, 0.3)   # Fr = (0.3 / 0.5 / (2.3 * 0.42)) ** (1 / 0.3) = 0.2044
     >>> round(v, 3)                               # sqrt(0.2044 * 9.81 * 0.42)
     0.918
@@ -247,8 +247,8 @@ def height_ranges(creature, rest_body: np.ndarray, hips_body: np.ndarray, legs) 
 
     Examples
     --------
-    >>> from scenarios import load_creature
-    >>> from planner._ik import legs_of
+    >>> from footfall.scenarios import load_creature
+    >>> from footfall.planner._ik import legs_of
     >>> q = load_creature("quadruped")
     >>> r = height_ranges(q, q.rest_feet, q.hips, legs_of(q))
     >>> bool((r[:, 0] <= 0.95 * q.standing_height + 1e-12).all() and (r[:, 1] >= 1.05 * q.standing_height - 1e-12).all())

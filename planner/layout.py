@@ -24,7 +24,7 @@ entries through the same constants. Nothing else defines an index.
 
 from __future__ import annotations
 
-from planner._params import (
+from footfall.planner._params import (
     C_CELL,
     C_MARGIN,
     C_OBST_MARGIN,
@@ -35,7 +35,7 @@ from planner._params import (
     C_SLICE_EPS,
     CONFIG_FIELDS,
 )
-from planner._timing import (
+from footfall.planner._timing import (
     T_DUTY_AT_REST,
     T_DUTY_MAX,
     T_DUTY_MIN,
@@ -45,7 +45,7 @@ from planner._timing import (
     T_STRIDE_EXPONENT,
     TIMING_FIELDS,
 )
-from planner._weights import (
+from footfall.planner._weights import (
     FOOTPRINT_TERMS,
     N_FOOTPRINT_TERMS,
     N_TERMS,

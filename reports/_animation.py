@@ -69,8 +69,8 @@ def joint_positions(recording, creature, characters: int | None = None) -> np.nd
     (straight hip -> planned foot legs where the IK was off), fed the recording's frames as one
     crowd of F x C characters.
     """
-    from planner._counters import rendered_joints
-    from planner._ik import legs_of
+    from footfall.planner._counters import rendered_joints
+    from footfall.planner._ik import legs_of
 
     f, c, legs = recording.in_stance.shape
     c = c if characters is None else min(c, characters)
@@ -94,7 +94,7 @@ def joint_positions(recording, creature, characters: int | None = None) -> np.nd
 def recording_scene(recording, scenario, creature, max_characters: int | None = None) -> dict:
     """The renderer's scene (:mod:`reports._render`) of a recording: terrain, the boxes at every
     frame, the first ``max_characters`` characters' tracks, footprints, bodies and legs."""
-    from planner._ik import body_rotation
+    from footfall.planner._ik import body_rotation
 
     n = recording.characters if max_characters is None else min(max_characters, recording.characters)
     joints = joint_positions(recording, creature, n)
@@ -133,13 +133,13 @@ def save_scene(scene: dict, path: Path) -> Path:
 
 
 def run_renderer(args: list[str], timeout: float, progress=None) -> dict | list:
-    """Run ``python -m reports._render ARGS``; returns its last stdout line (JSON). ``progress(k, n)``
+    """Run ``python -m footfall.reports._render ARGS``; returns its last stdout line (JSON). ``progress(k, n)``
     for its ``frame K N`` lines. A crash, a timeout or no result raise :class:`RenderError` (one line)."""
     import threading
 
     env = dict(os.environ, VTK_DEFAULT_OPENGL_WINDOW=os.environ.get("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow"))
     with tempfile.TemporaryFile(mode="w+") as err:
-        proc = subprocess.Popen([sys.executable, "-m", "reports._render", *args], stdout=subprocess.PIPE,
+        proc = subprocess.Popen([sys.executable, "-m", "footfall.reports._render", *args], stdout=subprocess.PIPE,
                                 stderr=err, text=True, env=env)
         timed_out = []
 
@@ -224,7 +224,7 @@ def recording_clip_scene(recording_path, frames: int | None = None,
                          max_characters: int | None = MAX_DRAWN_CHARACTERS) -> dict:
     """The scene of the first ``frames`` frames of a recording (``footfall render --recording F``);
     an :class:`InputError` for a file that is not a recording of a known scenario and creature."""
-    from reports._recording import load_recording
+    from footfall.reports._recording import load_recording
 
     run = load_recording(recording_path)
     if not run.scenario:

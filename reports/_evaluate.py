@@ -103,8 +103,9 @@ def replay_command(run: dict) -> str:
 def run_one(task: dict) -> dict:
     """One run (a task of :func:`footfall._distribute.run_tasks`): its summary and violations; with
     ``task['picture']``, also the pelvis paths and footprints for a picture."""
-    from footfall._runs import recorded_run, resolve_gait
-    from scenarios import load_creature, load_scenario
+    from footfall.reports._runs import recorded_run
+    from footfall.scenarios._gait_choice import resolve_gait
+    from footfall.scenarios import load_creature, load_scenario
 
     scenario = load_scenario(task["scenario"])
     creature = load_creature(task["creature"])

@@ -5,8 +5,8 @@ from __future__ import annotations
 import html
 import math
 
-from reports._pareto import COLUMNS, LOSS_TOLERANCE_PCT, PAIRED_COLUMNS
-from reports._sweep import stride_law_text
+from footfall.reports._pareto import COLUMNS, LOSS_TOLERANCE_PCT, PAIRED_COLUMNS
+from footfall.reports._sweep import stride_law_text
 
 STYLE = """
 body { font-family: system-ui, sans-serif; margin: 2em auto; max-width: 1200px; color: #222; }
@@ -208,7 +208,7 @@ def write_index(path, *, analysis: dict, results: list[dict], meta: dict, scenes
 
 def lod_section(lod: dict) -> list[str]:
     """The level-of-detail section: cost against crowd size, and quality per level (issue 15)."""
-    from reports._lod_report import LEVEL_TABLE
+    from footfall.reports._lod_report import LEVEL_TABLE
 
     parts = ["<h2>Level of detail: cost and quality per level</h2>"]
     if lod["scaling"]:
@@ -240,7 +240,7 @@ def load_matrix() -> dict | None:
     """The stored preset x terrain matrix (``tuning/data/matrix.json``, ``footfall bench presets``), or None."""
     import json
 
-    from tuning._matrix import MATRIX_FILE
+    from footfall.tuning._matrix import MATRIX_FILE
 
     if not MATRIX_FILE.exists():
         return None

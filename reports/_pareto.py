@@ -36,7 +36,7 @@ from collections import defaultdict
 
 import numpy as np
 
-from reports._sweep import FAR_LEVEL
+from footfall.reports._sweep import FAR_LEVEL
 
 LOSS_TOLERANCE_PCT = 0.25
 COST = "paired_cost_vs_first_valid"

@@ -77,7 +77,7 @@ def pareto_plot(analysis: dict, path) -> None:
 
 def stride_plot(results: list[dict], path) -> None:
     """Every kept (speed, stride) sample, by scenario, and the target curve per hip height."""
-    from reports._sweep import stride_law_text, target_stride_length
+    from footfall.reports._sweep import stride_law_text, target_stride_length
 
     fig = Figure(figsize=(7.0, 4.8), layout="constrained")
     ax = fig.subplots()

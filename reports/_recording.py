@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from footfall._errors import InputError
-from planner._simulation import RECORDING_FORMAT, RECORDING_VERSION
+from footfall.planner._simulation import RECORDING_FORMAT, RECORDING_VERSION
 
 OPTIONAL_ARRAYS = ("foot_yaw", "speed", "lod_level")
 """Per-frame arrays a recording may lack (written before they were kept; ``lod_level`` with LOD off)."""
@@ -92,7 +92,7 @@ class Recording:
 
     def load_creature(self):
         """The recorded creature: a built-in by name, or the user's creature file the recording carries."""
-        from scenarios import load_creature, load_creature_text
+        from footfall.scenarios import load_creature, load_creature_text
 
         text = self.header.get("creature_toml")
         if isinstance(text, str):
@@ -111,7 +111,7 @@ class Recording:
     def load_scenario(self):
         """The recorded scenario: the user's scenario file it was run from, while that file is where
         it was (its height maps and creature files are found relative to it), else a built-in by name."""
-        from scenarios import load_scenario
+        from footfall.scenarios import load_scenario
 
         file = self.header.get("scenario_file")
         if isinstance(file, str) and Path(file).is_file():

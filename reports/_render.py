@@ -3,13 +3,13 @@
 Run in its own process, so that a crash of VTK (no GL library on the machine) cannot take the
 caller with it; the callers set ``VTK_DEFAULT_OPENGL_WINDOW=vtkEGLRenderWindow`` (headless EGL).
 
-``python -m reports._render SCENE.npz OUT_DIR [--regions FILE.json]``
+``python -m footfall.reports._render SCENE.npz OUT_DIR [--regions FILE.json]``
     Writes ``scene_overview.png`` (the whole run: every track, the crowd at the last frame) and
     ``scene_closeup.png`` (the first character at the last frame and what is around it) into
     OUT_DIR and prints their names as one JSON list on stdout. ``--regions`` also writes, per
     picture, each drawn character's screen box and the legend's, ``[left, top, right, bottom]``
     in pixels (the tests look for the creature's pixels there).
-``python -m reports._render clip SCENE.npz OUT.mp4|OUT.gif --camera follow|fixed --width W --height H --fps F``
+``python -m footfall.reports._render clip SCENE.npz OUT.mp4|OUT.gif --camera follow|fixed --width W --height H --fps F``
     Renders every frame of the scene into a video (H.264 in MP4 through imageio's ffmpeg
     plugin, whose package ships its own ffmpeg; or an animated GIF through Pillow). Prints
     ``frame K N`` after each frame and, last, one JSON object (path, frames, fps, size).
@@ -36,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
-from reports._box_mesh import box_corners, faces_of
+from footfall.reports._box_mesh import box_corners, faces_of
 
 WINDOW = (1024, 720)
 MAX_TERRAIN_SAMPLES = 240  # per side: finer terrain adds nothing at this picture size
@@ -530,7 +530,7 @@ def main(argv: list[str]) -> int:
 
     os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
     if argv and argv[0] == "clip":
-        parser = argparse.ArgumentParser(prog="python -m reports._render clip")
+        parser = argparse.ArgumentParser(prog="python -m footfall.reports._render clip")
         parser.add_argument("scene")
         parser.add_argument("out")
         parser.add_argument("--camera", choices=("follow", "fixed"), default="follow")
@@ -542,7 +542,7 @@ def main(argv: list[str]) -> int:
                              progress=lambda k, n: print(f"frame {k} {n}", flush=True))
         print(json.dumps(result), flush=True)
         return 0
-    parser = argparse.ArgumentParser(prog="python -m reports._render")
+    parser = argparse.ArgumentParser(prog="python -m footfall.reports._render")
     parser.add_argument("scene")
     parser.add_argument("out_dir")
     parser.add_argument("--regions", default=None)

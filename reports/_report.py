@@ -19,7 +19,7 @@ from pathlib import Path
 from footfall._atomic import make_folder
 from footfall._errors import InputError
 from footfall._distribute import check_workers, run_tasks
-from reports import _html, _lod_report, _pareto, _plots, _sweep
+from footfall.reports import _html, _lod_report, _pareto, _plots, _sweep
 
 REPORT_FORMAT = "footfall-report"
 REPORT_VERSION = 1
@@ -72,7 +72,7 @@ def _publish(tmp: Path, out: Path) -> None:
 def load_recording(path) -> dict:
     """A recording's header and arrays; InputError when it is not a footfall recording of the
     version this footfall reads (the checks of :func:`reports._recording.load_recording`)."""
-    from reports._recording import load_recording as load_validated
+    from footfall.reports._recording import load_recording as load_validated
 
     rec = load_validated(path)
     if not rec.header.get("scenario"):
@@ -86,7 +86,7 @@ def render_run(recording, out_dir: Path, *, max_characters: int = 10) -> tuple[l
     report): (PNG names, clip name or None, error or None). The creatures are drawn from the
     recording's IK joints (:mod:`reports._animation`); at most ``max_characters`` of them and the
     first :data:`CLIP_MAX_FRAMES` frames."""
-    from reports._animation import RenderError, render_clip, render_stills, run_scene
+    from footfall.reports._animation import RenderError, render_clip, render_stills, run_scene
 
     out_dir.mkdir(parents=True, exist_ok=True)
     try:
@@ -106,8 +106,8 @@ def render_run(recording, out_dir: Path, *, max_characters: int = 10) -> tuple[l
 
 def _scene_recording(name: str, seed: int, characters: int, frames: int, work: Path):
     """A recorded run of the scenario's crowd for its pictures and clip (no LOD, default weights)."""
-    from footfall._runs import recorded_run, recording_meta
-    from reports._recording import load_recording as load_validated
+    from footfall.reports._runs import recorded_run, recording_meta
+    from footfall.reports._recording import load_recording as load_validated
 
     scenario, creature, gait = _sweep._load_inputs(name)
     model, summary, recorder = recorded_run(scenario, creature, gait, frames=frames, characters=characters,

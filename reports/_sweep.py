@@ -40,8 +40,8 @@ import time
 import numpy as np
 
 from footfall._errors import InputError
-from planner._batch import plan_batch
-from planner._simulation import realised_strides
+from footfall.planner._batch import plan_batch
+from footfall.planner._simulation import realised_strides
 
 TIMING_REPEATS = 3  # rounds of the paired benchmark (the best per batch and budget counts)
 OWN_TIMING_EVERY = 4  # a run's own requests: every n-th planning call is timed once (cheap, noisier)
@@ -70,7 +70,7 @@ def parse_setting(name: str) -> dict:
             raise ValueError
         couples = None if parts[1][1:] == "inf" else int(parts[1][1:])
         slices = None if parts[2][1:] == "none" else float(parts[2][1:])
-        from planner import SearchBudget
+        from footfall.planner import SearchBudget
 
         SearchBudget(couples, slices)
     except (ValueError, IndexError):
@@ -170,7 +170,7 @@ def build_tasks(options: SweepOptions) -> list[dict]:
 
 def check_scenarios(names) -> None:
     """Load every scenario once so a bad name fails before any work (InputError)."""
-    from scenarios import load_scenario
+    from footfall.scenarios import load_scenario
 
     for name in names:
         load_scenario(name)
@@ -228,7 +228,7 @@ class PlanTap:
         if plans.batch is not None and len(plans.calls) <= 1:
             self.pending.append((plans.batch, out, model.weights, model.config, state.lod_level[cs]))
             return
-        from planner._crowd import _boxes_now, stage_maps
+        from footfall.planner._crowd import _boxes_now, stage_maps
 
         for batch, config, rows, chars in plans.calls:
             if config is not model.config:
@@ -239,7 +239,7 @@ class PlanTap:
 
     def flush(self) -> None:
         """Exhaustive scores, timed re-plans and curvature of the plans since the last flush."""
-        from planner import EXHAUSTIVE, FIRST_VALID
+        from footfall.planner import EXHAUSTIVE, FIRST_VALID
 
         for batch, out, weights, config, levels in self.pending:
             self.calls += 1
@@ -300,8 +300,8 @@ def plan_far(batch, weights, first, fallback):
     """A far character's planning (``planner._far_planning``) of ``batch`` on one core: the first
     try near the preferred footprints, the full first-valid search for the feet it left without a
     couple. Returns the BatchResult of every foot."""
-    from planner._crowd import _merge_results, _take_requests
-    from planner._params import FIRST_VALID
+    from footfall.planner._crowd import _merge_results, _take_requests
+    from footfall.planner._params import FIRST_VALID
 
     batch = with_budget(batch, *FIRST_VALID.kernel_args())
     out = plan_batch(batch, weights, first, "search", False)
@@ -361,7 +361,7 @@ def target_stride_length(speed, hip_height: float, creature: str = "spider"):
     """The biomechanics target lambda = coefficient h Fr^exponent, Fr = v^2 / (g h), m: the
     creature's ``stride_length`` entry of ``tuning/data/targets.toml`` (2.3 h Fr^0.3, Alexander
     1976), the one definition the tuning fits to (``tuning._targets`` does not load JAX)."""
-    from planner._timing import GRAVITY
+    from footfall.planner._timing import GRAVITY
 
     t = _stride_target(creature)
     v = np.asarray(speed, dtype=np.float64)
@@ -370,13 +370,13 @@ def target_stride_length(speed, hip_height: float, creature: str = "spider"):
 
 @functools.lru_cache(maxsize=None)
 def _stride_target(creature: str) -> dict:
-    from tuning._targets import load_targets
+    from footfall.tuning._targets import load_targets
 
     return dict(load_targets(creatures=(creature,))[creature]["stride_length"].values)
 
 
 def _load_inputs(scenario_name: str):
-    from scenarios import default_gait_name, load_creature, load_gait, load_scenario
+    from footfall.scenarios import default_gait_name, load_creature, load_gait, load_scenario
 
     scenario = load_scenario(scenario_name)
     creature = load_creature(scenario.crowd.creature)
@@ -387,9 +387,9 @@ def _load_inputs(scenario_name: str):
 def _run_crowd(task: dict, recorder_frames: bool = True, keep_every: int = 0, keep_feet: int = 0,
                measure: bool = True):
     """Simulate the task's crowd; returns (scenario, model, state, summary, recorder, tap)."""
-    from planner import SearchBudget
-    from planner._crowd import init_crowd
-    from planner._simulation import Recorder, simulate
+    from footfall.planner import SearchBudget
+    from footfall.planner._crowd import init_crowd
+    from footfall.planner._simulation import Recorder, simulate
 
     scenario, creature, gait = _load_inputs(task["scenario"])
     budget = None
@@ -485,7 +485,7 @@ def _levels_with_loss(levels: dict | None, exhaustive: np.ndarray, deficit: np.n
     against the exhaustive search (% of the exhaustive score) and how many plans it rests on."""
     if levels is None:
         return None
-    from planner._lod import LEVEL_NAMES
+    from footfall.planner._lod import LEVEL_NAMES
 
     out = {**levels, "levels": {name: dict(row) for name, row in levels["levels"].items()}}
     for k, name in enumerate(LEVEL_NAMES):
@@ -502,7 +502,7 @@ def run_lod_scaling(task: dict) -> dict:
     """ms per frame against crowd size for the three LOD modes (``footfall bench crowd``'s
     measurement: one crowd per mode, stepped in turns so they share the machine's load; the median
     frame with its 95 % interval, and LOD on / LOD off with a bootstrap interval)."""
-    from benchmarks.crowd_bench import run
+    from footfall.benchmarks.crowd_bench import run
 
     _, creature, _ = _load_inputs(task["scenario"])
     sizes = run(sizes=tuple(task["sizes"]), frames=task["frames"], warmup=task["warmup"], seed=task["seed"],
@@ -526,7 +526,7 @@ def run_paired(task: dict) -> dict:
     another program hits all budgets alike, which a comparison of separate runs cannot
     promise. Quality: the same plans' couple scores against the exhaustive search's.
     """
-    from planner import EXHAUSTIVE, FIRST_VALID
+    from footfall.planner import EXHAUSTIVE, FIRST_VALID
 
     scenario, model, state, summary, recorder, tap = _run_crowd(task, recorder_frames=False,
                                                                 keep_every=PAIRED_KEEP_EVERY,
@@ -535,11 +535,11 @@ def run_paired(task: dict) -> dict:
     args = []
     for name in names:
         p = parse_setting(name)
-        from planner import SearchBudget
+        from footfall.planner import SearchBudget
 
         args.append(SearchBudget(p["couples_after_first"], p["slice_size_m"], paper_early_stop=True).kernel_args())
-    from planner._far_planning import far_configs
-    from planner._lod import LodConfig
+    from footfall.planner._far_planning import far_configs
+    from footfall.planner._lod import LodConfig
 
     lod = LodConfig()
     span = model.rest_radius + model.config.search_radius_m + float(np.max(model.reach))
@@ -626,7 +626,7 @@ def footprint_situation(sample, n_other: int = 14) -> dict:
     with a candidate disc of half a cell around each of ``n_other`` candidates spread over
     the score order (so that cell is the only target).
     """
-    from planner import FootQuery, GridFrame, LocalMaps, SearchBudget, plan_foot
+    from footfall.planner import FootQuery, GridFrame, LocalMaps, SearchBudget, plan_foot
 
     batch, out, k, weights, config, _ = sample
     ch = int(batch.foot_char[k])

@@ -44,9 +44,9 @@ import numpy as np
 
 from footfall._atomic import atomic_path, unwritable_reason
 from footfall._errors import InputError
-from planner._ik import legs_of, rest_pose_angles
-from reports._box_mesh import BOX_CORNERS, faces_of
-from reports._recording import Recording
+from footfall.planner._ik import legs_of, rest_pose_angles
+from footfall.reports._box_mesh import BOX_CORNERS, faces_of
+from footfall.reports._recording import Recording
 
 USD_SUFFIXES = (".usda", ".usdc", ".usd")
 """Output extensions USD knows (it picks text or crate from the extension; .usd is crate)."""

@@ -10,8 +10,8 @@ arrays. Bad input raises :class:`footfall._errors.InputError`. The TOML file
 formats are described in ``scenarios/README.md``.
 """
 
-from scenarios._creatures import Creature
-from scenarios._files import (
+from footfall.scenarios._creatures import Creature
+from footfall.scenarios._files import (
     builtin_creature_names,
     builtin_scenario_names,
     load_creature,
@@ -20,7 +20,7 @@ from scenarios._files import (
     split_variant,
     variant_name,
 )
-from scenarios._gaits import (
+from footfall.scenarios._gaits import (
     DEFAULT_GAIT,
     Gait,
     builtin_gait_names,
@@ -31,16 +31,16 @@ from scenarios._gaits import (
     min_stance_feet,
     required_stance_feet,
 )
-from scenarios._generators import (
+from footfall.scenarios._generators import (
     CrateRecipe,
     flat_heightfield,
     hills_heightfield,
     random_crates,
     stairs_heightfield,
 )
-from scenarios._obstacles import Obstacles
-from scenarios._scenario import Camera, CrowdSpawn, Scenario
-from scenarios._terrain import Heightfield
+from footfall.scenarios._obstacles import Obstacles
+from footfall.scenarios._scenario import Camera, CrowdSpawn, Scenario
+from footfall.scenarios._terrain import Heightfield
 
 DEFAULT_SCENARIO = "mixed"
 """The scenario used when none is named."""

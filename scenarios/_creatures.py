@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from scenarios._arrays import frozen_array, invalid, positive_float, readonly
+from footfall.scenarios._arrays import frozen_array, invalid, positive_float, readonly
 
 REST_REACH_FRACTION = 0.98
 """A rest foot may be at most this fraction of its leg's reach from its hip."""

@@ -14,10 +14,10 @@ from typing import Any
 import numpy as np
 
 from footfall._errors import InputError
-from scenarios import _schema as schema
-from scenarios._arrays import UNATTRIBUTED, one_line
-from scenarios._creatures import Creature
-from scenarios._generators import (
+from footfall.scenarios import _schema as schema
+from footfall.scenarios._arrays import UNATTRIBUTED, one_line
+from footfall.scenarios._creatures import Creature
+from footfall.scenarios._generators import (
     CrateRecipe,
     flat_heightfield,
     hills_heightfield,
@@ -26,10 +26,10 @@ from scenarios._generators import (
     stairs_heightfield,
     terrain_loop,
 )
-from scenarios._heightmaps import read_heightmap
-from scenarios._obstacles import STATIC, VELOCITY, WAYPOINTS, Obstacles
-from scenarios._scenario import Camera, CrowdSpawn, Scenario
-from scenarios._terrain import Heightfield
+from footfall.scenarios._heightmaps import read_heightmap
+from footfall.scenarios._obstacles import STATIC, VELOCITY, WAYPOINTS, Obstacles
+from footfall.scenarios._scenario import Camera, CrowdSpawn, Scenario
+from footfall.scenarios._terrain import Heightfield
 
 DATA_DIR = Path(__file__).parent / "data"
 """Built-in scenarios (``*.toml``)."""
@@ -129,7 +129,7 @@ def file_kind(name_or_path: str | Path) -> str:
     gait; ``legs``, ``foot``, ``standing_height``, ...: a creature; ``[terrain]``,
     ``[crowd]``, ...: a scenario). Raises :class:`InputError` for a file with none of them.
     """
-    from scenarios._gaits import builtin_gait_names
+    from footfall.scenarios._gaits import builtin_gait_names
 
     text = str(name_or_path)
     if isinstance(name_or_path, str) and not _is_file(Path(text)):
@@ -441,7 +441,7 @@ def _crowd_gait(reference: str, creature: Creature, base: Path, file: str) -> st
     A gait file's own problems name the gait file and its field; a name or path that leads
     nowhere, or a built-in gait that does not fit the creature, names ``FILE: crowd.gait``.
     """
-    from scenarios._gaits import DEFAULT_GAIT, builtin_gait_names, load_gait
+    from footfall.scenarios._gaits import DEFAULT_GAIT, builtin_gait_names, load_gait
 
     names = builtin_gait_names()
     if reference == DEFAULT_GAIT or reference in names:

@@ -18,7 +18,7 @@ one gait.
 
 from __future__ import annotations
 
-from planner._gait_schedule import GaitSchedule
+from footfall.planner._gait_schedule import GaitSchedule
 
 BUILTIN_SCHEDULES: dict[str, tuple[tuple[str, ...], tuple[float, ...]]] = {
     "quadruped": (("quadruped-walk", "quadruped-trot"), (0.25,)),
@@ -40,7 +40,7 @@ def gait_schedule(creature, gait=None) -> GaitSchedule:
         default gait alone).
     """
     from footfall._errors import InputError
-    from scenarios._gaits import load_gait
+    from footfall.scenarios._gaits import load_gait
 
     if gait is not None:
         value = gait if hasattr(gait, "swing_start") else load_gait(gait, creature)
@@ -55,7 +55,7 @@ def gait_schedule(creature, gait=None) -> GaitSchedule:
 
 
 def _default_gait(creature):
-    import scenarios._gaits as gaits
+    import footfall.scenarios._gaits as gaits
 
     if hasattr(gaits, "default_gait"):
         return gaits.default_gait(creature)

@@ -52,10 +52,10 @@ import numpy as np
 from pydantic import Field
 
 from footfall._errors import InputError
-from scenarios import _schema as schema
-from scenarios._arrays import UNATTRIBUTED, frozen_array, invalid, readonly
-from scenarios._creatures import Creature
-from scenarios._files import _read_toml, _resolve, _split_field, file_creature, load_creature
+from footfall.scenarios import _schema as schema
+from footfall.scenarios._arrays import UNATTRIBUTED, frozen_array, invalid, readonly
+from footfall.scenarios._creatures import Creature
+from footfall.scenarios._files import _read_toml, _resolve, _split_field, file_creature, load_creature
 
 GAITS_DIR = Path(__file__).parent / "data" / "gaits"
 """Built-in gaits (``*.toml``)."""

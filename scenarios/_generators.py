@@ -11,9 +11,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from scenarios._arrays import finite_float, invalid, positive_float
-from scenarios._obstacles import STATIC, VELOCITY, WAYPOINTS, Obstacles
-from scenarios._terrain import Heightfield
+from footfall.scenarios._arrays import finite_float, invalid, positive_float
+from footfall.scenarios._obstacles import STATIC, VELOCITY, WAYPOINTS, Obstacles
+from footfall.scenarios._terrain import Heightfield
 
 MAX_TERRAIN_CELLS = 4096 * 4096
 """Largest terrain grid (samples) a generator or loader will build."""

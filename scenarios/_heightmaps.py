@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from footfall._errors import InputError
-from scenarios._arrays import one_line
+from footfall.scenarios._arrays import one_line
 
 PNG_FULL_SCALE = 65535
 """A 16-bit PNG sample of this value maps to ``height_scale`` metres."""

@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from scenarios._arrays import finite_float, frozen_array, invalid, readonly
+from footfall.scenarios._arrays import finite_float, frozen_array, invalid, readonly
 
 STATIC = 0
 """``motion_kind`` of a box that never moves."""

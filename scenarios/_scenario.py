@@ -7,9 +7,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from scenarios._arrays import finite_float, frozen_array, invalid, positive_float, readonly
-from scenarios._obstacles import Obstacles
-from scenarios._terrain import Heightfield
+from footfall.scenarios._arrays import finite_float, frozen_array, invalid, positive_float, readonly
+from footfall.scenarios._obstacles import Obstacles
+from footfall.scenarios._terrain import Heightfield
 
 HEADING_MODES = ("fixed", "random")
 _GOLDEN_ANGLE = math.pi * (3.0 - math.sqrt(5.0))

@@ -15,7 +15,7 @@ from typing import Annotated, Any, Literal, Union
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from footfall._errors import InputError
-from scenarios._arrays import one_line
+from footfall.scenarios._arrays import one_line
 
 
 class _Model(BaseModel):

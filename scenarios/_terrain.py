@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from scenarios._arrays import finite_float, frozen_array, invalid, positive_float
+from footfall.scenarios._arrays import finite_float, frozen_array, invalid, positive_float
 
 
 @dataclass(frozen=True, eq=False)

@@ -63,7 +63,7 @@ def pytest_report_header(config):
 # for that process (then loads the kernel from the cache) rather than compiling it too.
 _PLANNER_WARM_UP = """
 import numpy as np
-from planner import FootQuery, GridFrame, LocalMaps, make_batch, plan_batch
+from footfall.planner import FootQuery, GridFrame, LocalMaps, make_batch, plan_batch
 n = 35
 ground = np.zeros((n, n))
 maps = LocalMaps(GridFrame(0.0, 0.0, 0.07, n, n), ground.copy(), ground, np.zeros((n, n), np.uint8))
@@ -73,7 +73,7 @@ plan_batch(make_batch([maps], [(0, query)]), parallel=True)
 """
 _RUN_WARM_UP = """
 import os, sys, time
-import planner._crowd as crowd
+import footfall.planner._crowd as crowd
 from footfall.cli import main
 planned = crowd.plan_batch
 def plan_batch(*args, **kwargs):

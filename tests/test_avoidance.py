@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from conftest import fresh_seeds
-from planner._kernels_avoidance import neighbour_lists, orca_velocities
+from footfall.planner._kernels_avoidance import neighbour_lists, orca_velocities
 
 DT = 1.0 / 30.0
 TAU = 2.0

@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from benchmarks import tuning_bench as tb
+from footfall.benchmarks import tuning_bench as tb
 from footfall import InputError
 
 pytestmark = pytest.mark.slow  # tuning benches (about 10 s)
@@ -31,7 +31,7 @@ def runs(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def tiny_setup():
-    from tuning._targets import load_targets
+    from footfall.tuning._targets import load_targets
 
     config = tb.make_config("spider", config_overrides=TINY)
     return config.exact_setup(), load_targets(creatures=("spider",))
@@ -51,7 +51,7 @@ def test_json_shape(runs):
 
 
 def test_proxy_counts_match_the_checkpoint(runs):
-    from tuning._tune import checkpoint_path
+    from footfall.tuning._tune import checkpoint_path
 
     result, _, folder = runs
     proxy = result["proxy"]
@@ -112,8 +112,8 @@ def test_stop_rule(tiny_setup):
 
 
 def test_search_space_starts_at_the_defaults():
-    from planner._timing import GaitTiming
-    from planner._weights import ScoringWeights
+    from footfall.planner._timing import GaitTiming
+    from footfall.planner._weights import ScoringWeights
 
     x0, lower, upper = tb.search_space()
     weights, timing = tb.decode(x0)
@@ -126,8 +126,8 @@ def test_search_space_starts_at_the_defaults():
 def test_both_methods_start_from_the_bench_setups_mis_tuned_timing():
     """CMA-ES's x0 and the tune's starting parameters are the same point: the default weights and
     the default timing with stride_coefficient 3.0 (strides 30 % too long)."""
-    from planner._timing import GaitTiming
-    from planner._weights import ScoringWeights
+    from footfall.planner._timing import GaitTiming
+    from footfall.planner._weights import ScoringWeights
 
     config = tb.make_config("spider")
     start = config.start()
@@ -164,7 +164,7 @@ def test_bad_arguments_name_the_argument(kwargs, name):
 def test_the_terrain_tune_comparison_counts_both_methods_on_the_same_runs():
     """``footfall bench tuning --scenarios``: the proxies' tune of the weights and CMA-ES on the same
     runs' loss (issue 18, item 6), tiny here."""
-    from benchmarks.tuning_bench import run_events, table
+    from footfall.benchmarks.tuning_bench import run_events, table
 
     result = run_events("spider", ("stairs",), max_evals=2, rounds=1,
                         config_overrides=dict(seeds=(0,), frames=90, spawn_fractions=(0.3,), harvest_frames=10,

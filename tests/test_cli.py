@@ -160,7 +160,7 @@ def test_progress_off_a_terminal_prints_a_line_per_step_and_every_few_seconds():
     import io
     import time
 
-    from footfall._progress import Progress
+    from footfall.cli._progress import Progress
 
     stream = io.StringIO()
     with Progress("footfall run", interval=0.2, stream=stream) as bar:

@@ -4,10 +4,10 @@ failure is fixed; counters measure the rendered pose (issue 20, item 2)."""
 import numpy as np
 import pytest
 
-from planner._counters import FrameCounters
-from planner._crowd import init_crowd, stage_ik
-from scenarios import load_creature, load_scenario
-from scenarios._gait_schedule import gait_schedule
+from footfall.planner._counters import FrameCounters
+from footfall.planner._crowd import init_crowd, stage_ik
+from footfall.scenarios import load_creature, load_scenario
+from footfall.scenarios._gait_schedule import gait_schedule
 
 
 def _standing(scenario="crates", creature="spider"):

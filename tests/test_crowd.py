@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 from conftest import footfall_cli
 
-from planner import PlannerConfig, WorldRaster
-from planner._crowd import hips_world, init_crowd, planner_config_for
-from planner._simulation import Recorder, simulate
-from scenarios import builtin_creature_names, builtin_scenario_names, default_gait_name, load_creature, load_gait, load_scenario
+from footfall.planner import PlannerConfig, WorldRaster
+from footfall.planner._crowd import hips_world, init_crowd, planner_config_for
+from footfall.planner._simulation import Recorder, simulate
+from footfall.scenarios import builtin_creature_names, builtin_scenario_names, default_gait_name, load_creature, load_gait, load_scenario
 
 FRAMES = 40
 SEEDS_PER_PAIR = 9  # 6 scenarios x 4 creatures x 9 seeds = 216 runs
@@ -181,7 +181,7 @@ def _scenario_text(terrain: str, speed: float) -> str:
 
 
 def test_a_feet_spacing_change_replans_swinging_feet_and_narrows_the_stance():
-    from planner._crowd import set_feet_spacing, step
+    from footfall.planner._crowd import set_feet_spacing, step
 
     scenario = load_scenario("flat")
     creature = load_creature("spider")
@@ -219,8 +219,8 @@ def test_a_hold_lowers_the_speed_limit_and_a_step_begun_standing_takes_the_walks
     """A hold (a stance leg that cannot follow and no room to lift it) stops the body for the frame
     and lowers its speed limit (sustainable speed), at most halving it; a step planned while the
     body stands swings in the time of the walk it resumes, not for the 1 s cap."""
-    from planner._crowd import ControllerConfig, stage_requests, step
-    from planner._timing import stride_frequency
+    from footfall.planner._crowd import ControllerConfig, stage_requests, step
+    from footfall.planner._timing import stride_frequency
 
     scenario, creature = load_scenario("flat"), load_creature("ant")
     model, state = init_crowd(scenario, creature, load_gait(default_gait_name("ant"), creature), n_characters=1,
@@ -253,7 +253,7 @@ def test_a_stance_foot_whose_leg_lost_it_steps_next_frame():
     """A pose taken back because a stance leg lost its foot (``unfollowed``) makes that foot step in
     the next requests, even though the look-ahead from the held body finds it reachable again: the
     body stood, moved, lost the foot and stood again, for good, while a crate ran over it."""
-    from planner._crowd import stage_requests
+    from footfall.planner._crowd import stage_requests
 
     model, state, args = _standing_on_flat("ant")
     before = (state.cannot_follow.copy(), state.unfollowed.copy())
@@ -271,7 +271,7 @@ def test_a_foot_the_body_waits_for_goes_before_the_gaits_own_swings():
     at once, so the lost foot found no room, frame after frame, while the other legs stepped in turn
     on the spot and the body waited for good (crates-moving, seed 0: 192 frames, a foot inside a
     crate). With no leg to spare (two in the air), nothing changes: the gait's swing goes."""
-    from planner._crowd import stage_requests
+    from footfall.planner._crowd import stage_requests
 
     model, state, args = _standing_on_flat("robot5")
     saved = {k: getattr(state, k).copy() for k in ("cannot_follow", "unfollowed", "wants_swing", "in_stance",
@@ -300,7 +300,7 @@ def test_a_foot_the_body_waits_for_goes_before_the_gaits_own_swings():
 def _standing_on_flat(creature_name):
     """(model, state, stage_requests' other arguments) of one character on ``flat`` after 30 frames,
     every foot put down, standing (speed 0: the look-ahead finds every foot reachable), nothing asked."""
-    from planner._crowd import ControllerConfig, step
+    from footfall.planner._crowd import ControllerConfig, step
 
     scenario, creature = load_scenario("flat"), load_creature(creature_name)
     model, state = init_crowd(scenario, creature, load_gait(default_gait_name(creature_name), creature),
@@ -324,7 +324,7 @@ def test_a_foot_in_the_air_when_its_sector_starts_lifts_again_on_landing():
     """The gait's turn is not lost because a foot was still swinging (a forced step, a late
     landing) when the needle entered its sector: the foot lifts again as soon as it lands, while
     the sector lasts. Losing it made the foot skip a whole cycle."""
-    from planner._crowd import step
+    from footfall.planner._crowd import step
 
     scenario, creature = load_scenario("flat"), load_creature("spider")
     model, state = init_crowd(scenario, creature, load_gait(default_gait_name("spider"), creature), n_characters=1,
@@ -350,7 +350,7 @@ def test_a_foot_in_the_air_when_its_sector_starts_lifts_again_on_landing():
 def test_crowds_spawn_as_far_apart_as_promised(scenario_name):
     """spawn_positions promises 1.5 rest radii between characters (crowds of 8 to 64 fit at that
     spacing in every built-in world); the spiral alone put its first two points 0.56 x apart."""
-    from planner._crowd import spawn_positions
+    from footfall.planner._crowd import spawn_positions
 
     scenario = load_scenario(scenario_name)
     for creature_name in builtin_creature_names():
@@ -367,7 +367,7 @@ def test_other_characters_feet_and_landing_spots_are_forbidden_in_a_characters_m
     under the spot a swinging foot of character 1 will land on, and nothing of its own feet."""
     import dataclasses
 
-    from planner._crowd import stage_maps
+    from footfall.planner._crowd import stage_maps
 
     scenario, creature = load_scenario("flat"), load_creature("spider")
     model, state = init_crowd(scenario, creature, load_gait(default_gait_name("spider"), creature), n_characters=2,
@@ -396,7 +396,7 @@ def test_a_crowd_spawns_with_every_foot_a_foots_room_from_the_other_characters_f
     """64 spiders spawned on ``mixed``: neighbours' legs interleave, and rest feet of two characters
     used to start on one spot (17 shared foot spots over the first frames, until they stepped). A rest
     foot within a foot's room of another character's moves straight away from it."""
-    from planner._crowd import _foot_room
+    from footfall.planner._crowd import _foot_room
 
     scenario, creature = load_scenario("mixed"), load_creature("spider")
     model, state = init_crowd(scenario, creature, load_gait(default_gait_name("spider"), creature),
@@ -436,7 +436,7 @@ def test_two_feet_planned_in_one_frame_never_share_a_spot_whether_of_one_charact
     rear legs landed on one spot and their legs crossed)."""
     import dataclasses
 
-    from planner._crowd import _foot_room, _same_frame_conflicts
+    from footfall.planner._crowd import _foot_room, _same_frame_conflicts
 
     scenario, creature = load_scenario("flat"), load_creature("spider")
     model, _ = init_crowd(scenario, creature, load_gait(default_gait_name("spider"), creature), n_characters=2,
@@ -465,7 +465,7 @@ def test_a_stance_leg_carried_across_another_leg_steps():
     # Two neighbouring stance feet of a standing spider swapped (as a body turning over its feet
     # carries them): their drawn legs cross, and the controller asks both to step now (kind 2, a
     # forced step); with the feet back, neither.
-    from planner._crowd import _boxes_now, stage_ik, stage_requests
+    from footfall.planner._crowd import _boxes_now, stage_ik, stage_requests
 
     scenario, creature = load_scenario("flat"), load_creature("spider")
     model, state = init_crowd(scenario, creature, load_gait(default_gait_name("spider"), creature), n_characters=1,
@@ -497,7 +497,7 @@ def test_a_turn_is_bounded_by_the_stance_feet_nearest_the_midline():
     # the feet keep STANCE_SIDE_MARGIN x the hip's 0.1 m offset (0.05 m) from the midline for turns
     # within +-(0.15 - 0.05) / 0.3 = +-1/3 rad. With the left front foot 0.05 m from the midline,
     # a turn that carries it further is refused (0), the other way it has 0.2 / 0.3.
-    from planner._crowd import STANCE_SIDE_MARGIN, leg_turn_bounds, stance_turn_bounds
+    from footfall.planner._crowd import STANCE_SIDE_MARGIN, leg_turn_bounds, stance_turn_bounds
 
     scenario, creature = load_scenario("flat"), load_creature("quadruped")
     model, state = init_crowd(scenario, creature, load_gait(default_gait_name("quadruped"), creature), n_characters=1,
@@ -527,7 +527,7 @@ def test_a_turn_that_would_carry_a_stance_leg_across_another_is_halved_then_refu
     # (hip to foot) do not cross. Turning right (negative angles) swings the front hip out and back
     # until the front leg's line sweeps over the hind foot: at the angle a* where the hind foot lies on
     # it (worked out below with a plain cross product, by bisection), the legs cross from then on.
-    from planner._crowd import turn_crossed_legs, uncrossing_turn
+    from footfall.planner._crowd import turn_crossed_legs, uncrossing_turn
 
     scenario, creature = load_scenario("flat"), load_creature("quadruped")
     model, state = init_crowd(scenario, creature, load_gait(default_gait_name("quadruped"), creature), n_characters=1,
@@ -573,7 +573,7 @@ def test_a_quadruped_turning_back_keeps_its_legs_uncrossed(monkeypatch):
     # Asked to walk back the way it faces, a quadruped turns on its feet: its front feet, 0.29 m ahead,
     # would be carried under the body and across each other by a free turn (crossings with the bound
     # lifted, below); bounded by its stance feet, it turns as it steps and its legs never cross.
-    import planner._crowd as crowd
+    import footfall.planner._crowd as crowd
 
     from conftest import fresh_seeds
 
@@ -609,8 +609,8 @@ def test_a_pose_that_draws_two_stood_legs_crossed_is_taken_back():
     # left by 0.05 rad, nothing crosses and the turn is kept; a pair already crossed at the frame's
     # start, or a leg in the air then, is not the pose's doing and takes nothing back; nor is anything
     # taken back from a character off screen (its legs are not drawn, its IK is skipped).
-    from planner._counters import count_polyline_crossings, rendered_joints
-    from planner._crowd import _pose, _take_back_crossing_poses, stage_ik
+    from footfall.planner._counters import count_polyline_crossings, rendered_joints
+    from footfall.planner._crowd import _pose, _take_back_crossing_poses, stage_ik
 
     model, state, (_, _, hips, _) = _standing_on_flat("spider")
     on = np.ones(1, np.bool_)
@@ -660,7 +660,7 @@ def test_a_tucked_foot_is_no_support_for_the_pelvis():
     # One foot tucked up near its hip (a tuck point half the hip's height above the ground) lands
     # nowhere: on flat ground the other seven give the pose of the eight, to the last bit. Counted as a foot standing at
     # its tuck point, it moved and tilted the body (checked with the tuck point as support).
-    from planner._crowd import stage_pelvis, tuck_swings
+    from footfall.planner._crowd import stage_pelvis, tuck_swings
 
     model, state, (_, _, hips, _) = _standing_on_flat("spider")
 

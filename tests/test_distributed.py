@@ -8,7 +8,7 @@ import pytest
 
 from footfall._errors import InputError
 from footfall._distribute import check_workers, run_tasks
-from reports._sweep import PRESETS, build_tasks, run_task, without_timings
+from footfall.reports._sweep import PRESETS, build_tasks, run_task, without_timings
 
 pytestmark = pytest.mark.slow  # worker processes (about 20 s)
 

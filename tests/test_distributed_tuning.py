@@ -13,9 +13,10 @@ import numpy as np
 import pytest
 
 from footfall._distribute import task_runner
-from planner import GaitTiming, ScoringWeights
-from planner._harvest import Harvest, _harvest_batch, _pack, harvest_chunk, harvest_situations, harvest_tasks
-from tuning._exact import ExactSetup, exact_metrics
+from footfall.planner import GaitTiming, Harvest, ScoringWeights
+from footfall.planner._harvest import _harvest_batch, pack_harvest
+from footfall.tuning._harvest_runs import harvest_chunk, harvest_situations, harvest_tasks
+from footfall.tuning._exact import ExactSetup, exact_metrics
 
 pytestmark = pytest.mark.slow  # worker processes (about 12 s)
 
@@ -28,9 +29,9 @@ def sequential_harvest(scenarios, creatures, *, seeds, frames, n_characters, wei
                        max_situations=None) -> Harvest:
     """The harvest as it was before the runs became tasks (one loop, one raster per scenario shared
     by its seeds, stop at the end of the frame that reaches the cap): the reference to match."""
-    from planner._crowd import init_crowd, planner_config_for, step
-    from planner._maps import WorldRaster
-    from scenarios import default_gait_name, load_creature, load_gait, load_scenario
+    from footfall.planner._crowd import init_crowd, planner_config_for, step
+    from footfall.planner._maps import WorldRaster
+    from footfall.scenarios import default_gait_name, load_creature, load_gait, load_scenario
 
     weights = weights or ScoringWeights()
     timing = timing or GaitTiming()
@@ -56,8 +57,8 @@ def sequential_harvest(scenarios, creatures, *, seeds, frames, n_characters, wei
                         _harvest_batch(plans.batch, model.weights, model.config, plans.result, plans.chars, plans.legs,
                                        plans.kinds, state, model, meta, rows)
                         if max_situations is not None and len(rows) >= max_situations:
-                            return _pack(rows, creatures, scenarios, weights.to_array(), timing.to_array())
-        return _pack(rows, creatures, scenarios, weights.to_array(), timing.to_array())
+                            return pack_harvest(rows, creatures, scenarios, weights.to_array(), timing.to_array())
+        return pack_harvest(rows, creatures, scenarios, weights.to_array(), timing.to_array())
     finally:
         numba.set_num_threads(threads)
 
@@ -169,7 +170,7 @@ def test_a_worker_killed_mid_run_costs_only_its_tasks(runner, kill_a_busy_worker
 
 
 def test_in_process_runner_and_planner_stay_without_dask():
-    code = ("import sys, planner._harvest\n"
+    code = ("import sys, footfall.planner._harvest\n"
             "from footfall._distribute import task_runner\n"
             "with task_runner(workers=1) as m:\n"
             "    assert m(lambda t: t['x'] * 2, [{'x': 1}, {'x': 2}]) == [2, 4]\n"

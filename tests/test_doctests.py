@@ -7,7 +7,8 @@ import pkgutil
 
 import pytest
 
-PACKAGES = ("planner", "scenarios", "tuning", "reports", "footfall", "benchmarks")
+PACKAGES = ("footfall.planner", "footfall.scenarios", "footfall.tuning", "footfall.reports", "footfall",
+            "footfall.cli", "footfall.benchmarks")
 
 
 def _modules_with_examples():
@@ -26,7 +27,8 @@ MODULES = _modules_with_examples()
 
 def test_the_examples_are_found():
     # A finder that found nothing would pass every module: at least the modules known to have examples.
-    assert {"planner._workspace", "planner._crowd", "planner._threads", "reports._evaluate"} <= set(MODULES)
+    assert {"footfall.planner._workspace", "footfall.planner._crowd", "footfall.planner._threads",
+            "footfall.reports._evaluate"} <= set(MODULES)
 
 
 @pytest.mark.parametrize("name", MODULES)

@@ -12,10 +12,10 @@ import numpy as np
 import pytest
 
 from conftest import fresh_seeds
-from planner._counters import FrameCounters
-from planner._crowd import DT, init_crowd, stage_steer, step
-from scenarios import load_creature, load_scenario
-from scenarios._gait_schedule import gait_schedule
+from footfall.planner._counters import FrameCounters
+from footfall.planner._crowd import DT, init_crowd, stage_steer, step
+from footfall.scenarios import load_creature, load_scenario
+from footfall.scenarios._gait_schedule import gait_schedule
 
 WORLD = """
 name = "{name}"
@@ -109,7 +109,7 @@ def test_a_crate_crossing_a_planned_swing_replans_it_the_same_frame(tmp_path, mo
     # against where a crate will be threat_horizon later too, so only a fast, narrow one gets between
     # those two poses onto a planned swing: this one must.) The body's avoidance (ORCA) is switched off
     # here: it keeps the feet clear of even this crate by waiting, and this test is about the swings.
-    import planner._crowd as crowd
+    import footfall.planner._crowd as crowd
 
     monkeypatch.setattr(crowd, "_avoid", lambda model, state, preferred, *_: (
         preferred, np.zeros(preferred.shape[0], np.bool_), np.zeros(preferred.shape[0], np.bool_)))
@@ -196,7 +196,7 @@ def test_avoidance_keeps_a_forbidden_crate_clear_of_the_body_for_its_horizon(tmp
     # straight at a crate face d ahead, at most (d - r) / tau toward it. Alone, the forbidden box's push
     # in stage_steer got a single spider round a crate (the test above) with or without it; in a crowd,
     # without it, neighbours pushed bodies to 5 cm from crates (12 spiders on crates, 600 frames).
-    from planner._crowd import AVOID_BOX_HORIZON, _avoid, _box_velocities, _boxes_now
+    from footfall.planner._crowd import AVOID_BOX_HORIZON, _avoid, _box_velocities, _boxes_now
 
     model, state = _world(tmp_path, "orca-box", crate_centre=(0.9, 0.0), crate_width=0.5, start=(0.0, 0.0),
                           goal=(3.0, 0.0))
@@ -224,7 +224,7 @@ def test_a_character_standing_still_is_avoided_with_the_whole_effort(tmp_path, m
     # 1121411189: 63 overlapping frames). Walking at its preferred velocity, A's new velocity is v + s u
     # (s its share of the change u that leaves the velocity obstacle): s = 1 against a standing B, 1/2
     # once B counts as able to make way (MOBILE_FRACTION 0: any speed).
-    import planner._crowd as crowd
+    import footfall.planner._crowd as crowd
 
     path = tmp_path / "pair.toml"
     path.write_text(WORLD.format(name="pair", crate=CRATE.format(centre=[5.0, 5.0], width=0.2, motion=""),
@@ -302,7 +302,7 @@ def test_a_character_in_a_crates_lane_heads_square_out_of_it_to_the_nearer_side(
     # centre, it takes the side of its way's right (+z: the lane's side axis for a crate going -x is
     # (0, -1), and the way has no part along it, so the tie goes to +z); 0.1 m to -z, it takes -z.
     # Behind the crate, or beside its lane, the way is kept.
-    from planner._crowd import _box_velocities, _boxes_now, _lane_exit
+    from footfall.planner._crowd import _box_velocities, _boxes_now, _lane_exit
 
     def lane_exit(model, state, way):
         boxes = _boxes_now(model, state.t)
@@ -326,7 +326,7 @@ def test_between_two_crates_lanes_the_way_out_leads_away_from_both(tmp_path):
     # cancel and the way (+x, into A) was kept. Walking at 0.3 m/s (rest radius + threat margin, 0.38 m,
     # added to each crate's half width, 0.63 m): +x meets A in 0.74 s and is inside B's reach for 1.26 s;
     # +z stays inside B's reach for 3.15 s; -z leaves it in 0.27 s and meets A only after 1.85 s. So -z.
-    from planner._crowd import _box_velocities, _boxes_now, _lane_exit
+    from footfall.planner._crowd import _box_velocities, _boxes_now, _lane_exit
 
     crates = "".join(CRATE.format(centre=list(c), width=0.5, motion='motion = { kind = "velocity", velocity = [-0.2, 0.0] }')
                      for c in ((1.0, 0.0), (0.0, 0.6)))
@@ -348,7 +348,7 @@ def test_a_foot_a_wide_crate_leaves_no_footprint_is_tucked_out_of_its_way(tmp_pa
     # (0.25 m about the same spots, down to z 0.05), but not the body. The left feet have nowhere to
     # step: each is tucked up near its hip (planner._crowd.tuck_swings, a quarter of its rest offset
     # out, z about 0.1) until the crate has passed, and lands again behind it.
-    import planner._crowd as crowd
+    import footfall.planner._crowd as crowd
 
     def run():
         model, state = _world(tmp_path, "tuck", crate_centre=(-1.8, 0.45), crate_width=0.6, start=(0.0, 0.0),
@@ -382,7 +382,7 @@ def test_a_foot_a_wide_crate_leaves_no_footprint_is_tucked_out_of_its_way(tmp_pa
 
 
 def test_a_tucked_foot_rises_first_then_moves_in_to_its_tuck_point(tmp_path):
-    from planner._crowd import TUCK_LIFT, TUCK_REACH, hips_world, tuck_points, tuck_swings
+    from footfall.planner._crowd import TUCK_LIFT, TUCK_REACH, hips_world, tuck_points, tuck_swings
 
     model, state = _world(tmp_path, "tuck-point", crate_centre=(5.0, 5.0), crate_width=0.2, start=(0.0, 0.0),
                           goal=(4.0, 0.0))
@@ -414,8 +414,8 @@ def test_a_tuck_point_inside_a_box_moves_in_to_the_first_clear_one(tmp_path):
     # Heading 0 (body forward +x, left +z). A tall box's near face runs along x, on the left, placed
     # so that the left feet at their first-choice tuck points (TUCK_REACH) would touch it and at the
     # next ones in would not; then closer, so that every choice touches it but the last.
-    from planner._crowd import TUCK_LIFT, TUCK_REACHES, hips_world, tuck_points
-    from planner._kernels_controller import foot_box_conflict
+    from footfall.planner._crowd import TUCK_LIFT, TUCK_REACHES, hips_world, tuck_points
+    from footfall.planner._kernels_controller import foot_box_conflict
 
     model, state = _world(tmp_path, "tuck-box", crate_centre=(5.0, 5.0), crate_width=0.2, start=(0.0, 0.0),
                           goal=(4.0, 0.0))
@@ -465,8 +465,8 @@ def test_a_stance_foot_that_stops_an_escape_and_finds_no_footprint_is_tucked(tmp
     # it across, so it bounds the turn to 0 and must step. No footprint is found anywhere (every plan
     # fails). Escaping, the foot is tucked (it leaves the ground, the turn is free of it); not
     # escaping, it stays down (a hold) and keeps the turn at 0.
-    import planner._crowd as crowd
-    from planner._crowd import STANCE_SIDE_MARGIN, hips_world, leg_turn_bounds
+    import footfall.planner._crowd as crowd
+    from footfall.planner._crowd import STANCE_SIDE_MARGIN, hips_world, leg_turn_bounds
 
     def run(escaping):
         model, state = _world(tmp_path, "escape", crate_centre=(5.0, 5.0), crate_width=0.2, start=(0.0, 0.0),
@@ -521,8 +521,8 @@ def test_an_escape_whose_orca_velocity_points_back_turns_to_the_lane_exits_side(
     # run). Alone, the spider turns to the exit's side and walks only as far along its heading as
     # that velocity goes (0: it points back). With a neighbour within four avoid radii, ORCA's
     # velocity (which knows of it) leads: the spider turns toward it, to the other side.
-    import planner._crowd as crowd
-    from planner._crowd import _boxes_now
+    import footfall.planner._crowd as crowd
+    from footfall.planner._crowd import _boxes_now
 
     model, state = _world(tmp_path, "back", crate_centre=(1.0, 0.0), crate_width=0.6, start=(0.0, 0.0),
                           goal=(4.0, 0.0), velocity=(-0.25, 0.0))
@@ -554,7 +554,7 @@ def test_an_escape_whose_orca_velocity_points_back_turns_to_the_lane_exits_side(
 def test_the_lane_kernel_is_the_lane_rule_written_out_in_numpy(seed):
     # planner._kernels_lanes.lane_threats against the rule written out here with whole arrays (as the
     # steering computed it before the kernel): random characters and boxes, every output bit for bit.
-    from planner._kernels_lanes import lane_threats
+    from footfall.planner._kernels_lanes import lane_threats
 
     rng = np.random.default_rng(seed)
     n, b = int(rng.integers(1, 60)), int(rng.integers(1, 6))

@@ -7,7 +7,7 @@ import pytest
 from typer.testing import CliRunner
 
 from footfall.cli import app
-from reports._evaluate import PROMISE_NAMES, violations
+from footfall.reports._evaluate import PROMISE_NAMES, violations
 
 SMALL = ["flat", "--creatures", "spider", "--seeds", "1", "--frames", "30", "--characters", "2", "--workers", "1"]
 
@@ -79,7 +79,7 @@ def test_random_seeds_are_printed(monkeypatch):
 
 
 def test_strict_fails_on_a_violation_and_a_plain_run_reports_it(monkeypatch, tmp_path):
-    import reports._evaluate as ev
+    import footfall.reports._evaluate as ev
 
     # A promise that every run breaks: a run walking at all "collides".
     broken = ev.Promise("collisions", "every run", lambda s, _n: 1)

@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 from footfall._errors import InputError
-from planner._gait import GaitManagerState, advance, init_gaits, set_destination, set_speed
-from planner._kernels_gait import duty_factor_k, scale_swing_durations_k, stride_frequency_k, stride_length_k
-from planner._timing import (
+from footfall.planner._gait import GaitManagerState, advance, init_gaits, set_destination, set_speed
+from footfall.planner._kernels_gait import duty_factor_k, scale_swing_durations_k, stride_frequency_k, stride_length_k
+from footfall.planner._timing import (
     GRAVITY,
     SWING_MAX,
     SWING_MIN,
@@ -25,7 +25,7 @@ from planner._timing import (
     stride_frequency,
     stride_length,
 )
-from scenarios import (
+from footfall.scenarios import (
     Gait,
     builtin_gait_names,
     default_gait_name,

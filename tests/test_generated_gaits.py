@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from footfall._errors import InputError
-from scenarios import Creature, default_gait, default_gait_name, generate_gait, load_creature, load_gait
-from scenarios._gaits import (
+from footfall.scenarios import Creature, default_gait, default_gait_name, generate_gait, load_creature, load_gait
+from footfall.scenarios._gaits import (
     DEFAULT_GAIT,
     check_support,
     leg_sides,

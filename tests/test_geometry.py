@@ -7,7 +7,7 @@ import pytest
 
 from conftest import fresh_seeds
 
-from planner._kernels_geometry import foot_offsets, rasterise_boxes, segments_cross, supercover_visit
+from footfall.planner._kernels_geometry import foot_offsets, rasterise_boxes, segments_cross, supercover_visit
 
 
 def _cells(ax, az, bx, bz, cell=1.0):
@@ -82,7 +82,7 @@ def test_points_near_on_a_hand_made_grid():
     """Five feet of two characters, radius 1 m. A query of character 0 at the origin: character 1's
     feet 0.5, 1.0 (exactly: included) and 1.0 m away, not the one 1.5 m away, nor its own foot. A
     query of character 1 at (0, 1): character 0's foot 0.82 m away."""
-    from planner._kernels_geometry import points_near
+    from footfall.planner._kernels_geometry import points_near
 
     points = np.array([[0.5, 0.0], [1.0, 0.0], [0.0, 1.0], [0.0, 1.5], [-0.2, 0.2]])
     owner = np.array([1, 1, 1, 1, 0])
@@ -94,7 +94,7 @@ def test_points_near_on_a_hand_made_grid():
 def test_points_near_equals_brute_force_on_random_crowds(seed):
     """Against a plain distance matrix (no grid): random feet of random owners, queries inside and
     outside their box, radii from a tenth to twice the spread."""
-    from planner._kernels_geometry import points_near
+    from footfall.planner._kernels_geometry import points_near
 
     rng = np.random.default_rng(seed)
     n, q = int(rng.integers(1, 300)), int(rng.integers(1, 60))

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-from planner._ik import (
+from footfall.planner._ik import (
     ABDUCTION_LIMIT,
     DEFAULT_AZIMUTH_LIMIT,
     UPRIGHT_LEG_OFFSET,
@@ -22,9 +22,9 @@ from planner._ik import (
     rest_pose_angles,
     solve_legs,
 )
-from planner._kernels_ik import body_rotation as body_rotation_kernel
-from planner._kernels_ik import forward_kinematics, nearest_in_limits
-from scenarios import builtin_creature_names, load_creature
+from footfall.planner._kernels_ik import body_rotation as body_rotation_kernel
+from footfall.planner._kernels_ik import forward_kinematics, nearest_in_limits
+from footfall.scenarios import builtin_creature_names, load_creature
 
 CREATURES = builtin_creature_names()
 HALF_PI = 0.5 * math.pi

@@ -6,11 +6,11 @@ import math
 import numpy as np
 import pytest
 
-from planner._gait_schedule import HYSTERESIS, GaitSchedule
-from planner._ik import legs_of
-from planner._timing import GRAVITY, GaitTiming, stride_length
-from planner._workspace import WINDOW_HEIGHTS, WINDOW_MARGIN, WINDOW_SAMPLES, duty_ceiling, speed_cap, stance_centres, stance_windows
-from scenarios import load_creature
+from footfall.planner._gait_schedule import HYSTERESIS, GaitSchedule
+from footfall.planner._ik import legs_of
+from footfall.planner._timing import GRAVITY, GaitTiming, stride_length
+from footfall.planner._workspace import WINDOW_HEIGHTS, WINDOW_MARGIN, WINDOW_SAMPLES, duty_ceiling, speed_cap, stance_centres, stance_windows
+from footfall.scenarios import load_creature
 
 UPRIGHT_LEG = """
 name = "stilt"
@@ -117,11 +117,11 @@ HILLS_BARS = dict(median=0.10, p90=0.25)
 
 
 def _walk(creature_name, scenario_name, froude, seed, frames=300):
-    from planner._crowd import init_crowd
-    from planner._simulation import simulate
-    from planner._timing import hip_height
-    from scenarios import load_scenario
-    from scenarios._gait_schedule import gait_schedule
+    from footfall.planner._crowd import init_crowd
+    from footfall.planner._simulation import simulate
+    from footfall.planner._timing import hip_height
+    from footfall.scenarios import load_scenario
+    from footfall.scenarios._gait_schedule import gait_schedule
 
     creature = load_creature(creature_name)
     speed = math.sqrt(froude * GRAVITY * hip_height(creature))

@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from planner._lod import LodConfig, frame_crowd, lod_budgets, visibility
+from footfall.planner._lod import LodConfig, frame_crowd, lod_budgets, visibility
 
 
 def test_zoomed_camera_shows_at_least_half_the_crowd_and_on_shows_all():
@@ -21,12 +21,12 @@ def test_budgets_fall_linearly_with_distance_and_are_minimal_off_screen():
 
 
 # --------------------------------------------------------------------------- levels that remove work (issue 15)
-from planner import WorldRaster  # noqa: E402
-from planner._crowd import init_crowd, planner_config_for, step  # noqa: E402
-from planner._ik import legs_of, rest_pose_angles, solve_legs  # noqa: E402
-from planner._lod import LEVEL_FAR, LEVEL_FULL, LEVEL_HIDDEN, lod_levels  # noqa: E402
-from planner._simulation import simulate  # noqa: E402
-from scenarios import default_gait_name, load_creature, load_gait, load_scenario  # noqa: E402
+from footfall.planner import WorldRaster  # noqa: E402
+from footfall.planner._crowd import init_crowd, planner_config_for, step  # noqa: E402
+from footfall.planner._ik import legs_of, rest_pose_angles, solve_legs  # noqa: E402
+from footfall.planner._lod import LEVEL_FAR, LEVEL_FULL, LEVEL_HIDDEN, lod_levels  # noqa: E402
+from footfall.planner._simulation import simulate  # noqa: E402
+from footfall.scenarios import default_gait_name, load_creature, load_gait, load_scenario  # noqa: E402
 
 _SPIDER = load_creature("spider")
 _MIXED = load_scenario("mixed")
@@ -146,8 +146,8 @@ def test_far_characters_near_a_moving_box_plan_on_the_papers_maps_with_more_coup
 
 
 def test_bench_crowd_reports_every_mode_with_intervals_and_the_on_off_ratio():
-    from benchmarks.crowd_bench import LARGE_SCENARIO, MODES, scenario_for
-    from benchmarks.crowd_bench import run as bench
+    from footfall.benchmarks.crowd_bench import LARGE_SCENARIO, MODES, scenario_for
+    from footfall.benchmarks.crowd_bench import run as bench
 
     out = bench(sizes=(6,), frames=4, warmup=1)
     row = out["6"]
@@ -168,7 +168,7 @@ def test_a_character_back_on_screen_still_stands_on_its_stance_feet():
     stance foot, and the first solve back on screen missed it by 32 mm (crates-moving, 8 quadrupeds,
     LOD zoomed, seed 556998574: hidden frames 239-244, back on screen at 245, found by a fresh seed of
     the long runs). Hidden characters are looked ahead with the two-bone solve, as far ones are."""
-    from footfall._runs import resolve_gait
+    from footfall.scenarios._gait_choice import resolve_gait
 
     scenario, creature = load_scenario("crates-moving"), load_creature("quadruped")
     gait, _, _ = resolve_gait(scenario, creature)

@@ -17,16 +17,16 @@ import numpy as np
 import pytest
 from conftest import fresh_seeds
 
-from planner._counters import CONTACT_TOLERANCE_M
-from planner._crowd import init_crowd
-from planner._kernels_controller import count_body_overlaps, count_collisions
-from planner._lod import LEVEL_HIDDEN, LEVEL_NAMES, LodConfig
-from planner._simulation import Recorder, simulate
-from planner._timing import stride_frequency
-from reports._animation import joint_positions
-from reports._lod_report import level_rows
-from reports._recording import load_recording
-from scenarios import default_gait_name, load_creature, load_gait, load_scenario
+from footfall.planner._counters import CONTACT_TOLERANCE_M
+from footfall.planner._crowd import init_crowd
+from footfall.planner._kernels_controller import count_body_overlaps, count_collisions
+from footfall.planner._lod import LEVEL_HIDDEN, LEVEL_NAMES, LodConfig
+from footfall.planner._simulation import Recorder, simulate
+from footfall.planner._timing import stride_frequency
+from footfall.reports._animation import joint_positions
+from footfall.reports._lod_report import level_rows
+from footfall.reports._recording import load_recording
+from footfall.scenarios import default_gait_name, load_creature, load_gait, load_scenario
 
 FRAMES = 90
 CHARACTERS = 8

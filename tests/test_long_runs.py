@@ -22,8 +22,8 @@ import warnings
 import pytest
 from conftest import fresh_seeds
 
-from reports._evaluate import replay_command, run_one
-from scenarios import builtin_creature_names, builtin_scenario_names
+from footfall.reports._evaluate import replay_command, run_one
+from footfall.scenarios import builtin_creature_names, builtin_scenario_names
 
 FRAMES = 600
 CHARACTERS = 8

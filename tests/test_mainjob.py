@@ -14,7 +14,7 @@ CLI = [sys.executable, "-m", "footfall.cli"]
 
 @pytest.mark.slow  # the whole main job (about 40 s; one run per session, conftest.main_job)
 def test_run_writes_every_output_into_one_folder(main_job):
-    from planner import load_preset
+    from footfall.planner import load_preset
     from pxr import Usd, UsdSkel
 
     out, summary = main_job

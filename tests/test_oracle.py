@@ -57,7 +57,7 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from conftest import fresh_seeds
-from planner import EXHAUSTIVE, FootQuery, GridFrame, LocalMaps, PlannerConfig, ScoringWeights, harvest_foot, plan_foot
+from footfall.planner import EXHAUSTIVE, FootQuery, GridFrame, LocalMaps, PlannerConfig, ScoringWeights, harvest_foot, plan_foot
 
 SCORE_TOL = 1e-9  # a score or goodness, dimensionless
 METRIC_TOL = 1e-9  # a raw metric (m, rad, or the scale-free energies, relative)
@@ -1150,9 +1150,9 @@ def test_hand_geometric_jerk():
     # k = 1..45 with u = k / 47 in [0.05, 0.95]: k = 3..44, 42 of them. J = L^3 * sum (4 a / h^3)^2 h
     # = (47 h)^3 * 42 * 16 a^2 / h^5 = 47^3 * 672 * (a / h)^2 = 103823 * 672 * 0.36 = 25116860.16;
     # goodness 1 / (1 + J / 2000) = 7.962144728146773e-05.
-    from planner._kernels_foot import JERK_SAMPLES as RUNTIME_JERK_SAMPLES
-    from planner._kernels_foot import geometric_jerk as runtime_jerk
-    from planner._kernels_foot import trajectory_goodness
+    from footfall.planner._kernels_foot import JERK_SAMPLES as RUNTIME_JERK_SAMPLES
+    from footfall.planner._kernels_foot import geometric_jerk as runtime_jerk
+    from footfall.planner._kernels_foot import trajectory_goodness
 
     assert RUNTIME_JERK_SAMPLES == JERK_SAMPLES
     i = np.arange(48)
@@ -1176,7 +1176,7 @@ def test_hand_goodness_formulas():
     # couple score, weights 3 1 1 1 1 2 1 0.5 1 0.5:
     # (2.4 + 0.75 + 0.75 + 0.4 + 1 + 1.3333333 + 0.6666667 + 0.25 + 0.6666667 + 0.125) / 12
     #   = 8.3416667 / 12 = 0.6951388888888889
-    from planner._kernels_foot import footprint_goodness, trajectory_goodness, weighted_mean
+    from footfall.planner._kernels_foot import footprint_goodness, trajectory_goodness, weighted_mean
 
     w = ScoringWeights().to_array()
     terms = np.zeros(10)

@@ -16,8 +16,8 @@ import math
 import numpy as np
 import pytest
 
-from planner import ControllerConfig
-from planner._kernels_body import pelvis_from_hulls
+from footfall.planner import ControllerConfig
+from footfall.planner._kernels_body import pelvis_from_hulls
 
 TOL = 1e-12  # m, rad
 STANDING, THICKNESS = 0.3, 0.01

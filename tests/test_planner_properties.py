@@ -13,8 +13,8 @@ import math
 import numpy as np
 import pytest
 
-from planner import EXHAUSTIVE, FIRST_VALID, DEFAULT_BUDGET, FootQuery, GridFrame, LocalMaps, PlannerConfig, plan_foot
-from planner._kernels_geometry import foot_offsets, rasterise_boxes
+from footfall.planner import EXHAUSTIVE, FIRST_VALID, DEFAULT_BUDGET, FootQuery, GridFrame, LocalMaps, PlannerConfig, plan_foot
+from footfall.planner._kernels_geometry import foot_offsets, rasterise_boxes
 
 N_LAYOUTS = 1000
 N = 40
@@ -215,7 +215,7 @@ def test_source_outside_the_maps_is_an_argument_error():
 
 
 def test_batch_kernel_equals_single_foot_calls():
-    from planner import make_batch, plan_batch
+    from footfall.planner import make_batch, plan_batch
 
     rng = np.random.default_rng(11)
     maps_list, requests, singles = [], [], []

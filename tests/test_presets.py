@@ -8,7 +8,7 @@ import pytest
 from conftest import footfall_cli
 
 from footfall import InputError
-from planner import GaitTiming, ScoringWeights, load_preset, preset_dict
+from footfall.planner import GaitTiming, ScoringWeights, load_preset, preset_dict
 
 
 def _write(tmp_path, data, name="p.json"):
@@ -66,7 +66,7 @@ def test_cli_takes_a_shipped_preset_by_name_and_refuses_an_unknown_name():
 
 
 def test_importing_tuning_for_its_presets_and_targets_does_not_load_jax():
-    code = ("import sys, tuning, tuning._targets; tuning.PRESETS_DIR; tuning._targets.load_targets(); "
+    code = ("import sys, footfall.tuning as tuning, footfall.tuning._targets; tuning.PRESETS_DIR; tuning._targets.load_targets(); "
             "assert 'jax' not in sys.modules, 'jax loaded'")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0, proc.stderr

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from planner import load_preset
+from footfall.planner import load_preset
 
 ROOT = Path(__file__).resolve().parents[1]
 PRESETS_DIR = ROOT / "tuning" / "data" / "presets"
@@ -16,7 +16,7 @@ MIN_WEIGHT_CHANGE = 0.20  # issue 18 item 4: some weight by >= 20 %
 
 
 def _matrix():
-    from tuning._matrix import MATRIX_FILE
+    from footfall.tuning._matrix import MATRIX_FILE
 
     if not MATRIX_FILE.exists():
         pytest.skip("no stored matrix (footfall bench presets --out tuning/data/matrix.json)")
@@ -24,13 +24,13 @@ def _matrix():
 
 
 def _shipped():
-    from tuning._matrix import PRESETS
+    from footfall.tuning._matrix import PRESETS
 
     return [name for name in PRESETS if (PRESETS_DIR / f"{name}.json").exists()]
 
 
 def test_the_matrix_proves_every_preset_with_enough_paired_runs():
-    from tuning._matrix import PRESETS, RUNS, TERRAINS
+    from footfall.tuning._matrix import PRESETS, RUNS, TERRAINS
 
     m = _matrix()
     assert m["runs_per_cell"] >= RUNS >= 30
@@ -60,7 +60,7 @@ def test_only_presets_that_pass_ship_and_each_is_the_file_the_matrix_proved():
 
 
 def test_a_shipped_terrain_preset_beats_the_defaults_at_home_and_loses_nowhere():
-    from tuning._matrix import LOSS_SE, PRESETS, WIN_SE
+    from footfall.tuning._matrix import LOSS_SE, PRESETS, WIN_SE
 
     m = _matrix()
     for name in _shipped():
@@ -80,8 +80,8 @@ def test_a_shipped_terrain_preset_beats_the_defaults_at_home_and_loses_nowhere()
 @pytest.mark.parametrize("name", ["spider-stairs", "quadruped-stairs", "ant-crates", "spider-mixed", "spider-cautious",
                                   "spider-surefooted", "spider-direct"])
 def test_a_shipped_preset_differs_from_the_defaults_and_records_its_tune(name):
-    from planner import ScoringWeights
-    from tuning._matrix import PRESETS
+    from footfall.planner import ScoringWeights
+    from footfall.tuning._matrix import PRESETS
 
     path = PRESETS_DIR / f"{name}.json"
     if not path.exists():
@@ -103,7 +103,7 @@ def test_a_shipped_preset_differs_from_the_defaults_and_records_its_tune(name):
 
 def _first_shipped_cell():
     """(matrix, preset name, its own terrain (or first terrain), that cell) of the first shipped preset."""
-    from tuning._matrix import PRESETS
+    from footfall.tuning._matrix import PRESETS
 
     m = _matrix()
     names = _shipped()
@@ -123,7 +123,7 @@ def _numbers(value):
 def test_the_cell_is_made_of_its_stored_runs():
     """The cell's numbers (means, SEs, collisions) are evaluate_cell of the runs the matrix stores
     one by one, which are the cell's spawns x seeds in order."""
-    from tuning._matrix import _clean, cell_setup, evaluate_cell, style_of
+    from footfall.tuning._matrix import _clean, cell_setup, evaluate_cell, style_of
 
     m, name, terrain, cell = _first_shipped_cell()
     runs = cell["runs"]
@@ -146,10 +146,10 @@ def test_runs_of_the_cell_are_reproduced_live():
     exactly (the runs are deterministic), so the matrix is what the presets do now."""
     from conftest import fresh_seeds
 
-    from planner import ScoringWeights
-    from tuning._events import EventSetup, event_metrics
-    from tuning._matrix import CHARACTERS, PRESETS, TERRAINS, _repo_path
-    from tuning._targets import load_tune_targets
+    from footfall.planner import ScoringWeights
+    from footfall.tuning._events import EventSetup, event_metrics
+    from footfall.tuning._matrix import CHARACTERS, PRESETS, TERRAINS, _repo_path
+    from footfall.tuning._targets import load_tune_targets
 
     m, name, terrain, cell = _first_shipped_cell()
     spec = PRESETS[name]

@@ -34,7 +34,7 @@ def recording(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def scene(recording):
-    from reports._animation import recording_clip_scene
+    from footfall.reports._animation import recording_clip_scene
 
     return recording_clip_scene(recording)
 
@@ -46,8 +46,8 @@ def _pixels(path):
 
 
 def test_the_scene_puts_legs_on_the_body_and_feet_on_the_ground(scene, recording):
-    from reports._recording import load_recording
-    from scenarios import load_creature
+    from footfall.reports._recording import load_recording
+    from footfall.scenarios import load_creature
 
     joints, pelvis, rotations = scene["joints"], scene["pelvis"], scene["rotations"]
     creature = load_creature("spider")
@@ -66,7 +66,7 @@ def test_the_scene_puts_legs_on_the_body_and_feet_on_the_ground(scene, recording
 
 def test_every_render_shows_the_creature(scene, tmp_path):
     """The same frame with and without the creatures: many pixels differ where the creature is."""
-    from reports._animation import render_stills
+    from footfall.reports._animation import render_stills
 
     size = (320, 240)
     with_dir, without_dir = tmp_path / "with", tmp_path / "without"
@@ -146,7 +146,7 @@ def test_bad_input_is_one_line_and_exit_2(recording, tmp_path, args, field):
 
 
 def test_a_failing_renderer_is_one_line(tmp_path):
-    from reports._animation import RenderError, run_renderer
+    from footfall.reports._animation import RenderError, run_renderer
 
     with pytest.raises(RenderError) as failure:
         run_renderer(["clip", str(tmp_path / "no-scene.npz"), str(tmp_path / "x.mp4")], timeout=120)
@@ -157,8 +157,8 @@ def test_a_failing_renderer_is_one_line(tmp_path):
 def test_a_recording_of_a_scenario_file_finds_its_scenario_again(tmp_path):
     # `footfall render my.toml` simulated, then looked the scenario up by its name ("unknown scenario"):
     # a recording of a user's scenario file carries the file's path, and its scene is built from it.
-    from reports._animation import recording_clip_scene
-    from reports._recording import load_recording
+    from footfall.reports._animation import recording_clip_scene
+    from footfall.reports._recording import load_recording
 
     scenario = tmp_path / "my-walk.toml"  # a name no built-in has
     scenario.write_text('name = "my-walk"\nseed = 0\n[terrain]\nkind = "flat"\nsize = [6.0, 6.0]\ncell_size = 0.05\n'

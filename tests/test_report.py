@@ -26,7 +26,7 @@ def quick(main_job):
     """The quick report of the session's main job (``footfall run --quick``: the quick sweep and the
     recording's renders; conftest.main_job): (folder, summary as ``footfall report --json`` prints it,
     read back from its ``results.json``). Its wall time is a benchmark, not a test:
-    ``python -m benchmarks.report_bench``."""
+    ``python -m footfall.benchmarks.report_bench``."""
     job_out, job = main_job
     out = job_out / "report"
     summary = {k: v for k, v in json.loads((out / "results.json").read_text()).items() if k != "tasks"}
@@ -93,7 +93,7 @@ def test_csv_and_json_agree(quick):
 
 @pytest.mark.slow  # the main job's quick report (conftest.main_job)
 def test_pareto_front_and_recommended_budget(quick):
-    from reports._pareto import COST, LOSS, dominates
+    from footfall.reports._pareto import COST, LOSS, dominates
 
     _, summary = quick
     budgets = [r for r in summary["rows"] if r["kind"] == "budget"]
@@ -120,7 +120,7 @@ def test_pareto_front_and_recommended_budget(quick):
 
 @pytest.mark.slow  # the main job's quick report (conftest.main_job)
 def test_lod_section_has_scaling_and_quality_per_level(quick):
-    from reports._lod_report import LEVEL_TABLE
+    from footfall.reports._lod_report import LEVEL_TABLE
 
     out, summary = quick
     lod = summary["lod"]
@@ -210,7 +210,7 @@ def _heatmap(scores, chosen_end):
 
 
 def test_footprint_plot_marks_the_chosen_cell_and_fits_its_colours_to_the_candidates(tmp_path):
-    from reports import _plots
+    from footfall.reports import _plots
 
     scores = np.linspace(0.78, 0.93, 9)
     h = _heatmap(scores, chosen_end=(0.5 + 0.07 + 0.01, 0.5 + 0.14 - 0.02))
@@ -226,7 +226,7 @@ def test_footprint_plot_marks_the_chosen_cell_and_fits_its_colours_to_the_candid
 
 
 def test_gait_disk_states_name_feet_off_their_schedule(tmp_path):
-    from reports import _plots
+    from footfall.reports import _plots
 
     # Needle at 0.3: sectors [0.2, 0.5) and [0.6, 0.9); each foot on the ground or in the air.
     scene = {"gait_needle": 0.3, "gait_start": np.array([0.2, 0.6, 0.2, 0.6]),
@@ -259,7 +259,7 @@ def _tiny_scene(path):
 def test_render_subprocess_writes_pictures_that_are_not_blank(tmp_path):
     scene = tmp_path / "scene.npz"
     _tiny_scene(scene)
-    proc = subprocess.run([sys.executable, "-m", "reports._render", str(scene), str(tmp_path)], capture_output=True,
+    proc = subprocess.run([sys.executable, "-m", "footfall.reports._render", str(scene), str(tmp_path)], capture_output=True,
                           text=True, timeout=300, env=HEADLESS)
     assert proc.returncode == 0, proc.stderr
     names = json.loads(proc.stdout.strip().splitlines()[-1])
@@ -351,7 +351,7 @@ def _one_line_error(proc, *needles):
 def test_report_json_prints_what_the_report_returns(tmp_path, monkeypatch):
     # The quick report's tests read the main job's report (conftest.main_job); the command's own --json
     # line is what build_report returns, passed its arguments as given.
-    import reports._report
+    import footfall.reports._report as report_module
 
     calls = []
 
@@ -359,7 +359,7 @@ def test_report_json_prints_what_the_report_returns(tmp_path, monkeypatch):
         calls.append((out, kwargs))
         return {"index": str(tmp_path / "r" / "index.html"), "rows": [{"setting": "lod-on"}]}
 
-    monkeypatch.setattr(reports._report, "build_report", build_report)
+    monkeypatch.setattr(report_module, "build_report", build_report)
     proc = footfall_cli("report", "--quick", "flat", "--seed", "3", "--workers", "1", "--out", str(tmp_path / "r"),
                         "--json")
     assert proc.returncode == 0, proc.stderr
@@ -402,7 +402,7 @@ def test_recording_from_another_version_is_refused(tmp_path):
 
 
 def test_a_failure_midway_leaves_the_previous_report_untouched(tmp_path):
-    from reports._report import REPORT_FORMAT, build_report
+    from footfall.reports._report import REPORT_FORMAT, build_report
 
     out = tmp_path / "report"
     out.mkdir()
@@ -425,7 +425,7 @@ def test_a_failure_midway_leaves_the_previous_report_untouched(tmp_path):
 
 
 def test_curvature_energy_of_an_arc_is_its_turn_squared_and_of_a_line_zero():
-    from reports._sweep import curvature_energy
+    from footfall.reports._sweep import curvature_energy
 
     for theta, radius in ((0.5, 0.1), (1.2, 3.0)):
         a = np.linspace(0.0, theta, 2001)
@@ -437,7 +437,7 @@ def test_curvature_energy_of_an_arc_is_its_turn_squared_and_of_a_line_zero():
 
 
 def test_realised_strides_and_target():
-    from reports._sweep import realised_strides, target_stride_length
+    from footfall.reports._sweep import realised_strides, target_stride_length
 
     # One foot touching down every 30 frames 0.3 m further, the pelvis at 0.3 m/s (dt 1/30): stride 0.3 m at 0.3 m/s.
     frames = 100
@@ -456,7 +456,7 @@ def test_realised_strides_and_target():
 
 
 def test_pareto_front_of_known_points():
-    from reports._pareto import pareto_front, recommend
+    from footfall.reports._pareto import pareto_front, recommend
 
     rows = [{"setting": s, "c": c, "l": l} for s, c, l in
             (("a", 1.0, 5.0), ("b", 2.0, 1.0), ("c", 3.0, 1.0), ("d", 2.5, 0.5), ("e", 4.0, 0.4), ("f", 1.5, 6.0))]
@@ -467,7 +467,7 @@ def test_pareto_front_of_known_points():
 
 
 def test_tasks_are_deterministic_for_a_seed():
-    from reports._sweep import parse_setting, run_task, without_timings
+    from footfall.reports._sweep import parse_setting, run_task, without_timings
 
     task = {"scenario": "crates", "seed": 3, "characters": 2, "frames": 20, "warmup": 5,
             **parse_setting("budget-c1-s0.20")}

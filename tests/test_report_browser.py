@@ -85,8 +85,8 @@ def chromium(*args, profile):
 @pytest.fixture(scope="module")
 def page(tmp_path_factory):
     """A folder with ``index.html``: the report's video markup for a 60-frame clip and two renders."""
-    from reports import _html
-    from reports._animation import recording_clip_scene, render_stills
+    from footfall.reports import _html
+    from footfall.reports._animation import recording_clip_scene, render_stills
 
     root = tmp_path_factory.mktemp("browser")
     recording = root / "flat.npz"

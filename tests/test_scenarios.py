@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 from PIL import Image
 
-import scenarios
+from footfall import scenarios
 from footfall._errors import InputError
-from scenarios import (
+from footfall.scenarios import (
     Camera,
     CrateRecipe,
     Creature,

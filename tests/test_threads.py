@@ -3,7 +3,7 @@
 import numba
 import pytest
 
-from planner import single_threaded
+from footfall.planner import single_threaded
 
 
 def test_single_threaded_runs_on_one_thread_and_gives_the_count_back_even_on_an_error():

@@ -10,7 +10,7 @@ import sys
 # One jitted program, compiled in a fresh process with the cache folder of the test.
 PROGRAM = """
 import json, jax, jax.numpy as jnp
-from tuning._config import enable_x64
+from footfall.tuning._config import enable_x64
 enable_x64()
 y = jax.jit(lambda x: jnp.tanh(x) * 3.0 + x ** 2)(jnp.arange(5.0))
 print(json.dumps({"dtype": str(y.dtype), "y": [float(v) for v in y],

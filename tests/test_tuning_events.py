@@ -25,7 +25,7 @@ def _write(tmp_path, text, name="t.toml"):
 
 
 def test_a_users_targets_file_overrides_the_stride_law_bands_and_states_a_style(tmp_path):
-    from tuning._targets import load_tune_targets
+    from footfall.tuning._targets import load_tune_targets
 
     path = _write(tmp_path, """schema_version = 1
 [sources]
@@ -61,7 +61,7 @@ max_touchdown_slope_rad = 0.2
 
 
 def test_the_shipped_style_files_load():
-    from tuning._targets import load_tune_targets
+    from footfall.tuning._targets import load_tune_targets
 
     for path in sorted(STYLES.glob("*.toml")):
         load_tune_targets(path, "spider")
@@ -83,7 +83,7 @@ def test_the_shipped_style_files_load():
      "source = \"nobody\"\n", "stride_length.source"),
 ])
 def test_a_malformed_targets_file_is_refused_naming_the_field(tmp_path, text, field):
-    from tuning._targets import load_tune_targets
+    from footfall.tuning._targets import load_tune_targets
 
     path = _write(tmp_path, text)
     with pytest.raises(InputError) as error:
@@ -116,8 +116,8 @@ def test_the_stride_law_is_read_from_the_targets_file_not_written_in_the_code():
 
 
 def test_the_sweep_follows_the_targets_stride_law(tmp_path):
-    from tuning._exact import sweep_froude
-    from tuning._targets import load_tune_targets
+    from footfall.tuning._exact import sweep_froude
+    from footfall.tuning._targets import load_tune_targets
 
     longer = load_tune_targets(_write(tmp_path, "schema_version = 1\n[stride_length]\ncoefficient = 3.0\n"
                                                 "exponent = 0.3\nrelative_tolerance = 0.15\n"), "spider")
@@ -127,8 +127,8 @@ def test_the_sweep_follows_the_targets_stride_law(tmp_path):
 
 
 def test_the_reports_stride_law_text_is_the_targets_files():
-    from reports._sweep import stride_law_text
-    from tuning._targets import load_tune_targets
+    from footfall.reports._sweep import stride_law_text
+    from footfall.tuning._targets import load_tune_targets
 
     t = load_tune_targets(None, "spider")
     c, e = t.stride_law
@@ -139,8 +139,8 @@ def test_the_reports_stride_law_text_is_the_targets_files():
 
 
 def test_a_spawn_along_the_route_is_a_variant_between_spawn_and_goal():
-    from scenarios import load_scenario
-    from tuning._events import spawn_variant
+    from footfall.scenarios import load_scenario
+    from footfall.tuning._events import spawn_variant
 
     assert spawn_variant("stairs", 0.0) == "stairs"
     name = spawn_variant("stairs@terrain.rise=0.1", 0.3)
@@ -154,9 +154,9 @@ def test_a_spawn_along_the_route_is_a_variant_between_spawn_and_goal():
 
 @pytest.fixture(scope="module")
 def one_run():
-    from planner._weights import ScoringWeights
-    from tuning._events import EventSetup, event_tasks, run_event_task
-    from tuning._targets import load_tune_targets
+    from footfall.planner._weights import ScoringWeights
+    from footfall.tuning._events import EventSetup, event_tasks, run_event_task
+    from footfall.tuning._targets import load_tune_targets
 
     targets = load_tune_targets(None, "spider")
     setup = EventSetup("spider", ("stairs",), seeds=(3,), frames=150, spawn_fractions=(0.3,))
@@ -166,8 +166,9 @@ def one_run():
 
 def test_a_run_is_footfall_simulate_and_its_metrics_are_the_simulations(one_run):
     """The per-event metrics reuse the simulation's summary (the run ``footfall simulate`` makes)."""
-    from footfall._runs import recorded_run, resolve_gait
-    from scenarios import load_creature, load_scenario
+    from footfall.reports._runs import recorded_run
+    from footfall.scenarios._gait_choice import resolve_gait
+    from footfall.scenarios import load_creature, load_scenario
 
     task, result, _ = one_run
     assert task["scenario"] in result["replay"] and "--frames 150" in result["replay"]
@@ -187,7 +188,7 @@ def test_a_run_is_footfall_simulate_and_its_metrics_are_the_simulations(one_run)
 
 
 def test_the_run_loss_is_its_formula(one_run):
-    from tuning._events import COLLISION_PENALTY, HOLDS_REF, run_loss, style_terms
+    from footfall.tuning._events import COLLISION_PENALTY, HOLDS_REF, run_loss, style_terms
 
     _, result, targets = one_run
     m = dict(result["metrics"])
@@ -210,7 +211,7 @@ def test_the_run_loss_is_its_formula(one_run):
 
 
 def _tiny_config(**changes):
-    from tuning._tune_events import EventTuneConfig
+    from footfall.tuning._tune_events import EventTuneConfig
 
     settings = dict(scenarios=("stairs",), rounds=2, seeds=(0, 1), frames=120, spawn_fractions=(0.3,),
                     harvest_frames=15, harvest_characters=1, max_situations=60, fit_steps=3, holdout_seeds=(7, 8))
@@ -220,7 +221,7 @@ def _tiny_config(**changes):
 
 @pytest.fixture(scope="module")
 def tiny_tunes(tmp_path_factory):
-    from tuning._tune_events import tune_events
+    from footfall.tuning._tune_events import tune_events
 
     folder = tmp_path_factory.mktemp("events")
     config = _tiny_config()
@@ -232,7 +233,7 @@ def tiny_tunes(tmp_path_factory):
 
 @pytest.mark.slow  # tiny terrain tunes (about 15 s)
 def test_a_tiny_terrain_tune_writes_a_preset_with_the_issues_json_keys(tiny_tunes):
-    from planner import load_preset
+    from footfall.planner import load_preset
 
     folder, config, whole, _, _ = tiny_tunes
     preset = load_preset(folder / "whole.json", "spider")
@@ -260,7 +261,7 @@ def test_a_killed_terrain_tune_resumes_to_the_same_preset(tiny_tunes):
 
 @pytest.mark.slow  # tiny terrain tunes (about 15 s)
 def test_a_checkpoint_of_other_settings_is_refused(tiny_tunes):
-    from tuning._tune_events import tune_events
+    from footfall.tuning._tune_events import tune_events
 
     folder, config, _, _, _ = tiny_tunes
     with pytest.raises(InputError, match="other settings"):
@@ -268,7 +269,7 @@ def test_a_checkpoint_of_other_settings_is_refused(tiny_tunes):
 
 
 def test_acceptance_needs_a_paired_gain_beyond_the_noise_and_no_more_collisions():
-    from tuning._tune_events import accept
+    from footfall.tuning._tune_events import accept
 
     def metrics(losses, collisions=0):
         return {"finite": True, "collisions": collisions, "exact_loss": float(np.mean(losses)),
@@ -292,7 +293,7 @@ def _events(values, key="stride_error", collisions=0, **other):
 
 
 def test_a_terrain_preset_passes_only_with_a_win_at_home_and_no_loss_elsewhere():
-    from tuning._matrix import evaluate_cell, verdict
+    from footfall.tuning._matrix import evaluate_cell, verdict
 
     rng = np.random.default_rng(0)
     base = 0.1 + 0.01 * rng.standard_normal(30)
@@ -318,7 +319,7 @@ def test_a_terrain_preset_passes_only_with_a_win_at_home_and_no_loss_elsewhere()
 
 
 def test_a_style_preset_passes_when_its_metric_moves_toward_its_bound():
-    from tuning._matrix import evaluate_cell, verdict
+    from footfall.tuning._matrix import evaluate_cell, verdict
 
     rng = np.random.default_rng(1)
     near = 0.2 + 0.02 * rng.standard_normal(30)
@@ -335,8 +336,8 @@ def test_a_style_preset_passes_when_its_metric_moves_toward_its_bound():
 
 
 def test_the_reports_matrix_section_shows_every_preset_its_cells_and_verdict():
-    from reports._html import matrix_section
-    from tuning._matrix import evaluate_cell, verdict
+    from footfall.reports._html import matrix_section
+    from footfall.tuning._matrix import evaluate_cell, verdict
 
     rng = np.random.default_rng(2)
     base = 0.1 + 0.01 * rng.standard_normal(30)
@@ -361,9 +362,9 @@ def test_a_clearance_style_starts_from_a_proximity_reference_as_far_as_its_bound
     reference, starts at the given weights."""
     import dataclasses
 
-    from planner._weights import W_PROXIMITY_REF, ScoringWeights
-    from tuning._targets import load_tune_targets
-    from tuning._tune_events import style_start
+    from footfall.planner._weights import W_PROXIMITY_REF, ScoringWeights
+    from footfall.tuning._targets import load_tune_targets
+    from footfall.tuning._tune_events import style_start
 
     default = {"weights": list(ScoringWeights().to_array()), "timing": [1.0]}
     plain = load_tune_targets(None, "spider")
@@ -384,8 +385,8 @@ def test_the_offset_block_is_off_only_for_a_style_with_a_clearance_bound():
     against a slope ceiling or no style, the stride law is kept too."""
     import dataclasses
 
-    from tuning._targets import load_tune_targets
-    from tuning._tune_events import offset_weight
+    from footfall.tuning._targets import load_tune_targets
+    from footfall.tuning._tune_events import offset_weight
 
     plain = load_tune_targets(None, "spider")
     assert offset_weight(plain) == 1.0

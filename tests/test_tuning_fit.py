@@ -3,8 +3,9 @@
 import numpy as np
 import pytest
 
-from planner import GaitTiming, ScoringWeights, harvest_situations
-from planner._timing import GRAVITY, TIMING_FIELDS
+from footfall.planner import GaitTiming, ScoringWeights
+from footfall.tuning import harvest_situations
+from footfall.planner._timing import GRAVITY, TIMING_FIELDS
 
 N_STEPS = 6
 TAU = 0.05
@@ -14,8 +15,8 @@ RESIDUAL_ATOL = 1e-12
 
 @pytest.fixture(scope="module")
 def problem():
-    import tuning
-    from tuning import _fit
+    from footfall import tuning
+    from footfall.tuning import _fit
 
     tuning.enable_x64()
     # Harvested with strides 30 % too long (stride_coefficient 3.0 for the law's 2.3), so that the fit
@@ -28,8 +29,8 @@ def problem():
 
 
 def test_the_stride_residuals_are_the_targets_law(problem):
-    import tuning
-    from tuning import _fit
+    from footfall import tuning
+    from footfall.tuning import _fit
 
     s = problem.situations
     r = np.asarray(_fit.residuals(_fit.initial_params(problem), problem))
@@ -60,7 +61,7 @@ def test_the_stride_correction_scales_the_commanded_stride(problem):
 
     import jax.numpy as jnp
 
-    from tuning import _fit
+    from footfall.tuning import _fit
 
     s = problem.situations
     mask = np.asarray(problem.stride_mask)
@@ -81,8 +82,8 @@ def test_the_duty_correction_shifts_the_duty_model(problem):
 
     import jax.numpy as jnp
 
-    import tuning
-    from tuning import _fit
+    from footfall import tuning
+    from footfall.tuning import _fit
 
     s = problem.situations
     mask = np.asarray(problem.duty_mask)
@@ -101,14 +102,14 @@ def test_the_duty_correction_shifts_the_duty_model(problem):
 
 
 def _targets():
-    import tuning
+    from footfall import tuning
 
     return tuning.load_targets(creatures=("spider", "ant"))
 
 
 @pytest.mark.slow  # jit-compiled fits (about 7 s each)
 def test_levenberg_marquardt_lowers_the_loss_and_keeps_parameters_valid(problem):
-    from tuning import _fit
+    from footfall.tuning import _fit
 
     loss0 = float(_fit.loss(_fit.initial_params(problem), problem))
     weights, timing, history = _fit.fit(problem, n_steps=N_STEPS)
@@ -125,7 +126,7 @@ def test_levenberg_marquardt_lowers_the_loss_and_keeps_parameters_valid(problem)
 
 
 def test_fit_arguments_are_checked(problem):
-    from tuning import _fit
+    from footfall.tuning import _fit
 
     with pytest.raises(ValueError, match="n_steps"):
         _fit.fit(problem, n_steps=0)
@@ -146,8 +147,8 @@ def terrain_problems():
     legacy fit sees them and with the weights' blocks (and a style whose ceilings the defaults cross)."""
     import dataclasses
 
-    import tuning
-    from tuning import _fit
+    from footfall import tuning
+    from footfall.tuning import _fit
 
     tuning.enable_x64()
     harvest = harvest_situations(scenarios=TERRAINS, creatures=("spider",), seeds=(0,), frames=30, n_characters=2)
@@ -165,7 +166,7 @@ def _weights_jacobian(problem):
     """d residuals (the targets' rows, without the prior) / d log weights at the harvest's parameters."""
     import jax
 
-    from tuning import _fit
+    from footfall.tuning import _fit
 
     y0 = _fit.initial_params(problem)
     n_prior = y0[0].size + y0[1].size
@@ -178,7 +179,7 @@ def _weights_jacobian(problem):
 
 @pytest.mark.slow  # jit-compiled fits (about 7 s each)
 def test_at_the_defaults_only_the_weights_blocks_give_the_weights_a_gradient(terrain_problems):
-    from planner._weights import N_TERMS
+    from footfall.planner._weights import N_TERMS
 
     _, legacy, weights = terrain_problems
     _, _, j_legacy = _weights_jacobian(legacy)
@@ -214,8 +215,8 @@ def test_the_weights_blocks_gradients_match_central_differences(terrain_problems
 
 
 def test_the_offset_block_is_the_expected_distance_to_the_preferred_footprint(terrain_problems):
-    import tuning
-    from tuning import _fit
+    from footfall import tuning
+    from footfall.tuning import _fit
 
     harvest, _, problem = terrain_problems
     s = problem.situations
@@ -235,7 +236,7 @@ def test_the_offset_block_is_the_expected_distance_to_the_preferred_footprint(te
 
 
 def test_a_weights_only_fit_moves_the_weights_and_holds_the_timing(terrain_problems):
-    from tuning import _fit
+    from footfall.tuning import _fit
 
     _, _, problem = terrain_problems
     loss0 = float(_fit.loss(_fit.initial_params(problem), problem))

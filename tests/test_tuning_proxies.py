@@ -3,10 +3,11 @@
 import numpy as np
 import pytest
 
-from planner import GaitTiming, ScoringWeights, harvest_situations
-from planner import _timing as runtime_timing
-from planner._timing import TIMING_FIELDS
-from planner._weights import WEIGHT_FIELDS
+from footfall.planner import GaitTiming, ScoringWeights
+from footfall.tuning import harvest_situations
+from footfall.planner import _timing as runtime_timing
+from footfall.planner._timing import TIMING_FIELDS
+from footfall.planner._weights import WEIGHT_FIELDS
 
 # At the harvest's timing the proxy recomputes the distance feature and d_ref with sqrt
 # instead of hypot: a few ulps on goodnesses in [0, 1] (see tests/test_tuning_scoring.py).
@@ -27,7 +28,7 @@ LIMIT_RTOL = 1e-12
 
 @pytest.fixture(scope="module")
 def situations():
-    import tuning
+    from footfall import tuning
 
     tuning.enable_x64()
     harvest = harvest_situations(scenarios=("crates",), creatures=("spider", "ant", "quadruped", "robot5"),
@@ -47,7 +48,7 @@ def point():
 def test_the_timing_model_is_the_runtime_one():
     import jax.numpy as jnp
 
-    import tuning
+    from footfall import tuning
 
     tuning.enable_x64()
     timing = GaitTiming(stride_exponent=0.27, duty_slope=0.3)
@@ -64,7 +65,7 @@ def test_the_timing_model_is_the_runtime_one():
 def test_at_the_harvest_timing_the_proxy_sees_the_runtime_scores(situations, point):
     import jax.numpy as jnp
 
-    import tuning
+    from footfall import tuning
 
     harvest, sit = situations
     keep = harvest.has_couple
@@ -80,7 +81,7 @@ def _mean_metrics(sit, tau):
     import jax
     import jax.numpy as jnp
 
-    import tuning
+    from footfall import tuning
 
     n_w = len(WEIGHT_FIELDS)
 
@@ -99,7 +100,7 @@ def test_proxy_gradients_match_central_differences(situations, point):
     import jax
     import jax.numpy as jnp
 
-    import tuning
+    from footfall import tuning
 
     _, sit = situations
     w, timing = point
@@ -129,7 +130,7 @@ def test_proxy_gradients_match_central_differences(situations, point):
 def test_soft_selection_tends_to_the_hard_choice_as_tau_goes_to_zero(situations, point):
     import jax.numpy as jnp
 
-    import tuning
+    from footfall import tuning
 
     _, sit = situations
     w = jnp.asarray(point[0])
@@ -172,7 +173,7 @@ def test_soft_selection_tends_to_the_hard_choice_as_tau_goes_to_zero(situations,
 def test_probabilities_are_a_distribution_over_the_valid_couples(situations, point):
     import jax.numpy as jnp
 
-    import tuning
+    from footfall import tuning
 
     _, sit = situations
     scores = tuning.couple_scores(jnp.asarray(point[0]), jnp.asarray(point[1]), sit)

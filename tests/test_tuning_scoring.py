@@ -10,8 +10,9 @@ functions evaluated on the harvest's raw features and metrics.
 import numpy as np
 import pytest
 
-from planner import FEATURES, RAW_METRICS, harvest_situations
-from planner._weights import FOOTPRINT_TERMS, N_FOOTPRINT_TERMS, SCORE_TERMS, TRAJECTORY_TERMS
+from footfall.planner import FEATURES, RAW_METRICS
+from footfall.tuning import harvest_situations
+from footfall.planner._weights import FOOTPRINT_TERMS, N_FOOTPRINT_TERMS, SCORE_TERMS, TRAJECTORY_TERMS
 
 MIN_CANDIDATE_SETS = 1000
 # The JAX and numba formulas are the same float64 operations on the same inputs; only the
@@ -35,7 +36,7 @@ def harvest():
 def jax_scores(harvest):
     import jax.numpy as jnp
 
-    import tuning
+    from footfall import tuning
 
     tuning.enable_x64()
     w = jnp.asarray(harvest.weights)
@@ -139,9 +140,9 @@ def test_bad_harvest_arguments_name_the_argument():
 
 
 def test_harvest_foot_holds_the_brute_force_optimum_of_plan_foot():
-    from planner import EXHAUSTIVE, PlannerConfig, WorldRaster, harvest_foot, plan_foot
-    from planner._situations import stand, step_queries
-    from scenarios import load_creature, load_scenario
+    from footfall.planner import EXHAUSTIVE, PlannerConfig, WorldRaster, harvest_foot, plan_foot
+    from footfall.planner._situations import stand, step_queries
+    from footfall.scenarios import load_creature, load_scenario
 
     scenario = load_scenario("crates")
     spider = load_creature("spider")

@@ -6,9 +6,9 @@ import tomllib
 import pytest
 
 from footfall._errors import InputError
-from planner._timing import hip_height
-from scenarios import builtin_creature_names, load_creature
-from tuning import QUANTITIES, TARGETS_FILE, load_targets
+from footfall.planner._timing import hip_height
+from footfall.scenarios import builtin_creature_names, load_creature
+from footfall.tuning import QUANTITIES, TARGETS_FILE, load_targets
 
 
 def test_the_targets_file_loads_for_every_creature_with_citations():

@@ -10,7 +10,7 @@ import pytest
 from conftest import footfall_cli
 
 from footfall import InputError
-from planner import load_preset
+from footfall.planner import load_preset
 
 PRESETS = Path(__file__).resolve().parents[1] / "tuning" / "data" / "presets"
 SHIPPED = ("spider", "ant", "quadruped", "robot5")
@@ -22,7 +22,7 @@ REQUIRED_SUMMARY = ("creature", "exact_loss_default", "exact_loss_tuned", "strid
 
 
 def _tiny(**changes):
-    from tuning._tune import TuneConfig
+    from footfall.tuning._tune import TuneConfig
 
     settings = dict(rounds=2, harvest_frames=20, harvest_characters=1, max_situations=40, fit_steps=3,
                     exact_scenarios=("flat",), exact_seeds=(0,), exact_frames=75, exact_characters=1,
@@ -34,7 +34,7 @@ def _tiny(**changes):
 @pytest.fixture(scope="module")
 def tiny_runs(tmp_path_factory):
     """An uninterrupted tiny run, and the same run killed after round 1 and resumed."""
-    from tuning._tune import checkpoint_path, tune
+    from footfall.tuning._tune import checkpoint_path, tune
 
     folder = tmp_path_factory.mktemp("tune")
     config = _tiny()
@@ -75,7 +75,7 @@ def test_a_killed_run_resumes_to_the_same_preset(tiny_runs):
 def test_a_mis_tuned_start_is_reported_beside_the_defaults(tiny_runs, tmp_path):
     """--start-timing: the search starts from the mis-tuned timing, the *_start keys report it, and
     the *_default keys still mean the runtime's defaults (the same numbers as a run without a start)."""
-    from tuning._tune import tune
+    from footfall.tuning._tune import tune
 
     _, _, whole, _, _, _ = tiny_runs
     started = tune(_tiny(rounds=1, start_timing=(("stride_coefficient", 3.0),)), tmp_path / "s.json", workers=1)
@@ -92,7 +92,7 @@ def test_a_mis_tuned_start_is_reported_beside_the_defaults(tiny_runs, tmp_path):
 
 @pytest.mark.slow  # tiny tunes (about 40 s)
 def test_bad_checkpoints_and_arguments_are_refused(tiny_runs, tmp_path):
-    from tuning._tune import checkpoint_path, tune
+    from footfall.tuning._tune import checkpoint_path, tune
 
     folder, config, _, _, _, _ = tiny_runs
     with pytest.raises(InputError, match="no checkpoint"):
@@ -148,7 +148,7 @@ def test_the_spider_preset_numbers_are_reproduced_live_and_stay_safe():
     """One held-out run (the first of the provenance's held-out sweep) recomputed: the same stride
     ratio bit for bit (the runs are deterministic), no collisions, curvature energy not above the
     default weights'."""
-    from tuning._exact import ExactSetup, exact_metrics
+    from footfall.tuning._exact import ExactSetup, exact_metrics
 
     preset = _spider_preset()
     config = preset.provenance["config"]
@@ -183,7 +183,7 @@ def test_shipped_presets_meet_the_stride_target_on_held_out_runs_without_collisi
 def test_a_shipped_preset_is_the_defaults_exactly_when_its_tune_accepted_no_candidate(creature):
     """best_round -1 (no candidate accepted) <=> the defaults bit for bit <=> the held-out numbers of
     the defaults (the runs are deterministic); a tuned preset must not lose on the held-out runs."""
-    from planner import GaitTiming, ScoringWeights
+    from footfall.planner import GaitTiming, ScoringWeights
 
     preset = load_preset(PRESETS / f"{creature}.json", creature)
     kept = preset.provenance["summary"]["best_round"] == -1
@@ -197,8 +197,8 @@ def test_a_shipped_preset_is_the_defaults_exactly_when_its_tune_accepted_no_cand
 def test_a_tune_that_accepts_no_candidate_keeps_the_defaults(tmp_path, monkeypatch):
     """Every step refused (here by a stand-in for the exact planner's verdict): the preset is the
     defaults bit for bit, and its held-out numbers are those of the defaults (the runs are deterministic)."""
-    import tuning._tune as tune_module
-    from planner import GaitTiming, ScoringWeights
+    import footfall.tuning._tune as tune_module
+    from footfall.planner import GaitTiming, ScoringWeights
 
     monkeypatch.setattr(tune_module, "_accept", lambda *args: (False, "refused (test)"))
     result = tune_module.tune(_tiny(rounds=1), tmp_path / "kept.json", workers=1)
@@ -216,8 +216,8 @@ def test_a_tuned_preset_that_walks_worse_on_the_held_out_runs_is_not_shipped(tmp
     """Every step accepted on the training runs, but the held-out runs (a stand-in for the exact planner
     there) find the tuned parameters' stride error higher than the defaults': the defaults ship, with the
     refused round named in the summary."""
-    import tuning._tune as tune_module
-    from planner import GaitTiming, ScoringWeights
+    import footfall.tuning._tune as tune_module
+    from footfall.planner import GaitTiming, ScoringWeights
 
     real = tune_module.exact_metrics
     config = _tiny(rounds=1)
@@ -247,7 +247,7 @@ def _metrics(run_losses, exact_loss):
 
 def test_a_candidate_must_beat_the_best_by_more_than_the_runs_noise():
     """paired_gain by hand: differences (0.5, 0.5, 1.0): mean 2/3, SD sqrt(1/12), SE 1/6."""
-    from tuning._tune import GAIN_NOISE_SE, _accept, paired_gain
+    from footfall.tuning._tune import GAIN_NOISE_SE, _accept, paired_gain
 
     best = _metrics([1.0, 2.0, 3.0], 1.0)
     better = _metrics([0.5, 1.5, 2.0], 0.5)
@@ -268,7 +268,7 @@ def test_a_candidate_must_beat_the_best_by_more_than_the_runs_noise():
 def test_guards_allow_the_higher_of_the_defaults_and_a_mis_tuned_start():
     """Median jerk: the defaults 1.0, the start 2.0. A candidate at 1.5 improves on the start and is
     accepted against the start (it would fail against the defaults alone); one at 2.5 is above both."""
-    from tuning._tune import JERK_GUARD, _accept
+    from footfall.tuning._tune import JERK_GUARD, _accept
 
     default = _metrics([1.0, 2.0, 3.0], 1.0)
     start = dict(_metrics([3.0, 4.0, 5.0], 4.0), jerk_median=2.0)

@@ -10,11 +10,11 @@ from conftest import footfall_cli
 from pxr import Gf, Usd, UsdGeom, UsdSkel, UsdValidation
 
 from footfall._errors import InputError
-from planner import body_rotation, init_crowd, legs_of
-from planner._ik import forward_legs
-from planner._simulation import Recorder, simulate
-from reports._recording import load_recording
-from reports._usd import (
+from footfall.planner import body_rotation, init_crowd, legs_of
+from footfall.planner._ik import forward_legs
+from footfall.planner._simulation import Recorder, simulate
+from footfall.reports._recording import load_recording
+from footfall.reports._usd import (
     _row_matrices,
     _world_matrices,
     bind_pose,
@@ -23,7 +23,7 @@ from reports._usd import (
     leg_mesh,
     skeleton_layout,
 )
-from scenarios import builtin_creature_names, default_gait_name, load_creature, load_gait, load_scenario
+from footfall.scenarios import builtin_creature_names, default_gait_name, load_creature, load_gait, load_scenario
 
 SCENARIO = "mixed"  # hills (a terrain that is not flat) and crates looping along waypoints
 CHARACTERS = 2
@@ -232,8 +232,8 @@ def test_a_recording_of_a_users_creature_exports_without_its_file(tmp_path):
     assert proc.returncode == 0, proc.stderr
     stage = Usd.Stage.Open(str(out))
     assert any(p.IsA(UsdSkel.Skeleton) for p in stage.Traverse())
-    from reports._recording import load_recording
-    from scenarios import load_creature
+    from footfall.reports._recording import load_recording
+    from footfall.scenarios import load_creature
 
     loaded = load_recording(recording).load_creature()
     shipped = load_creature(str(Path(__file__).parents[1] / "scenarios" / "examples" / "heptapod.toml"))

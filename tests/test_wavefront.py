@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from planner import wavefront_distances
+from footfall.planner import wavefront_distances
 
 R2 = math.sqrt(2.0)
 INF = np.inf

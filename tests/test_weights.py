@@ -3,7 +3,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from planner import WEIGHT_FIELDS, PlannerConfig, ScoringWeights, SearchBudget
+from footfall.planner import WEIGHT_FIELDS, PlannerConfig, ScoringWeights, SearchBudget
 
 
 def test_array_round_trip_is_lossless():

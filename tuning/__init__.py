@@ -1,7 +1,7 @@
 """Tuning of the scoring weights and the gait timing with JAX (issue 4).
 
 * :mod:`tuning._scoring`: the runtime's goodnesses and scores, exactly, from the
-  harvest's raw numbers (``planner.harvest_situations``).
+  harvest's raw numbers (``footfall.tuning.harvest_situations``).
 * :mod:`tuning._proxies`: a soft selection (temperature tau) over the harvested
   couples: expected step length, curvature energy, clearance, climb, jerk as
   smooth functions of the weights and of the gait-timing parameters.
@@ -39,6 +39,7 @@ _EXPORTS = {
     **dict.fromkeys(("PROXY_METRICS", "Situations", "couple_scores", "duty_factor", "expected_metrics",
                      "hard_metrics", "preferred_footprint", "preferred_lead_time", "situations_from_harvest",
                      "soft_selection", "stride_frequency", "stride_length"), "_proxies"),
+    **dict.fromkeys(("harvest_chunk", "harvest_situations", "harvest_tasks"), "_harvest_runs"),
     **dict.fromkeys(("QUANTITIES", "TARGETS_FILE", "CreatureTargets", "Target", "load_targets"), "_targets"),
     **dict.fromkeys(("couple_score", "couple_terms", "footprint_goodness", "footprint_score", "trajectory_goodness",
                      "trajectory_score", "weighted_mean"), "_scoring"),
@@ -48,8 +49,8 @@ _EXPORTS = {
 def __getattr__(name: str):
     module = _EXPORTS.get(name)
     if module is None:
-        raise AttributeError(f"module 'tuning' has no attribute {name!r}")
-    value = getattr(import_module(f"tuning.{module}"), name)
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(import_module(f".{module}", __name__), name)
     globals()[name] = value
     return value
 

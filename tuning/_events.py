@@ -59,8 +59,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planner import task_mapper
-from planner.layout import RAW_CURVATURE
+from footfall.planner import task_mapper
+from footfall.planner.layout import RAW_CURVATURE
 
 EVENT_FRAMES = 300
 SPAWN_FRACTIONS = (0.15, 0.3, 0.45)
@@ -124,7 +124,7 @@ def spawn_variant(name: str, fraction: float) -> str:
     to its goal (``fraction`` 0: ``name`` itself). Where that spawn overlaps a box (the scenario refuses
     it), the first of :data:`SPAWN_NUDGES` that loads: deterministic, so a task carries a plain string."""
     from footfall._errors import InputError
-    from scenarios import load_scenario
+    from footfall.scenarios import load_scenario
 
     if fraction == 0.0:
         return name
@@ -169,8 +169,8 @@ def replay_command(task: dict, preset: str = "PRESET.json") -> str:
 
 def run_event_task(task: dict) -> dict:
     """One run of :func:`event_tasks`: the simulation's summary and the plan metrics (picklable)."""
-    from footfall._runs import resolve_gait
-    from planner import (
+    from footfall.scenarios._gait_choice import resolve_gait
+    from footfall.planner import (
         GaitTiming,
         ScoringWeights,
         arrived,
@@ -180,8 +180,8 @@ def run_event_task(task: dict) -> dict:
         simulate,
         single_threaded,
     )
-    from planner.layout import W_SLOPE_CRITICAL, W_STEP_CRITICAL
-    from scenarios import load_creature, load_scenario
+    from footfall.planner.layout import W_SLOPE_CRITICAL, W_STEP_CRITICAL
+    from footfall.scenarios import load_creature, load_scenario
 
     weights = ScoringWeights.from_array(task["weights"])
     timing = GaitTiming.from_array(task["timing"])

@@ -58,8 +58,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planner import realised_strides, task_mapper
-from planner.layout import RAW_CLEARANCE, RAW_CURVATURE, RAW_JERK
+from footfall.planner import realised_strides, task_mapper
+from footfall.planner.layout import RAW_CLEARANCE, RAW_CURVATURE, RAW_JERK
 
 STRIDE_MIN_CELLS = 1.5
 """Lowest speed of the sweep: where the target stride is this many planner cells. Footprints are
@@ -77,9 +77,9 @@ def sweep_froude(creature_name: str, targets=None) -> tuple[float, ...]:
     Fr_lo = max(FROUDE_FLOOR, Fr at which lambda_target = STRIDE_MIN_CELLS cells),
     Fr_hi = max(SWEEP_RATIO Fr_lo, FROUDE_CEILING_MIN). lambda_target is the stride law of
     ``targets`` (:class:`tuning._targets.CreatureTargets`; None: the shipped targets file)."""
-    from planner import hip_height, planner_config_for
-    from scenarios import load_creature
-    from tuning._targets import load_tune_targets
+    from footfall.planner import hip_height, planner_config_for
+    from footfall.scenarios import load_creature
+    from footfall.tuning._targets import load_tune_targets
 
     creature = load_creature(creature_name)
     h = hip_height(creature)
@@ -131,8 +131,8 @@ class ExactSetup:
 
 def speeds_for(setup: ExactSetup) -> np.ndarray:
     """The sweep's desired speeds (m/s): v = sqrt(Fr g h)."""
-    from planner import GRAVITY, hip_height
-    from scenarios import load_creature
+    from footfall.planner import GRAVITY, hip_height
+    from footfall.scenarios import load_creature
 
     h = hip_height(load_creature(setup.creature))
     return np.sqrt(np.asarray(setup.froude, dtype=np.float64) * GRAVITY * h)
@@ -141,8 +141,8 @@ def speeds_for(setup: ExactSetup) -> np.ndarray:
 def run_one(creature_name: str, scenario_name: str, seed: int, speed: float, weights, timing, frames: int,
             warmup: int, n_characters: int) -> dict:
     """One crowd run at desired speed ``speed``; the raw measures (module docstring)."""
-    from planner import init_crowd, planner_config_for, simulate
-    from scenarios import default_gait_name, load_creature, load_gait, load_scenario
+    from footfall.planner import init_crowd, planner_config_for, simulate
+    from footfall.scenarios import default_gait_name, load_creature, load_gait, load_scenario
 
     creature = load_creature(creature_name)
     gait = load_gait(default_gait_name(creature.name), creature)
@@ -183,7 +183,7 @@ _RASTERS: dict = {}
 
 
 def _raster(name, cell, scenario):
-    from planner import WorldRaster
+    from footfall.planner import WorldRaster
 
     key = (name, cell)
     if key not in _RASTERS:
@@ -197,7 +197,7 @@ def exact_tasks(setup: ExactSetup, weights=None, timing=None) -> list[dict]:
     Parameters travel as lists of floats (``weights`` None: the planner's defaults), so a task
     carries every input of its run and gives the same result wherever it runs.
     """
-    from planner import GaitTiming
+    from footfall.planner import GaitTiming
 
     timing = timing or GaitTiming()
     speeds = speeds_for(setup)
@@ -214,7 +214,7 @@ def exact_tasks(setup: ExactSetup, weights=None, timing=None) -> list[dict]:
 def run_exact_task(task: dict) -> dict:
     """:func:`run_one` for a task of :func:`exact_tasks`, tagged with its scenario, seed and speed.
     The result holds numpy arrays (``speed``, ``stride``, ``raw``): picklable, for a worker to send back."""
-    from planner import GaitTiming, ScoringWeights, single_threaded
+    from footfall.planner import GaitTiming, ScoringWeights, single_threaded
 
     weights = None if task["weights"] is None else ScoringWeights.from_array(task["weights"])
     timing = GaitTiming.from_array(task["timing"])
@@ -232,8 +232,8 @@ def exact_metrics(setup: ExactSetup, weights=None, timing=None, targets=None, ma
     -> list`` (results in task order, e.g. from ``footfall._distribute.task_runner``) runs them, on
     workers or not; None runs them here, one after the other. The result is the same, bit for bit.
     """
-    from planner import GaitTiming, duty_factor as commanded_duty, stride_length as commanded_stride
-    from tuning._targets import load_targets
+    from footfall.planner import GaitTiming, duty_factor as commanded_duty, stride_length as commanded_stride
+    from footfall.tuning._targets import load_targets
 
     run = task_mapper(map_tasks)
     timing = timing or GaitTiming()

@@ -77,9 +77,9 @@ import jax.numpy as jnp
 import numpy as np
 import optimistix as optx
 
-from planner import GRAVITY
-from planner.layout import TIMING_FIELDS
-from tuning._proxies import Situations, duty_factor, expected_metrics, stride_frequency
+from footfall.planner import GRAVITY
+from footfall.planner.layout import TIMING_FIELDS
+from footfall.tuning._proxies import Situations, duty_factor, expected_metrics, stride_frequency
 
 FITTED_TIMING = ("stride_coefficient", "stride_exponent", "duty_at_rest", "duty_slope")
 _FITTED_INDEX = np.array([TIMING_FIELDS.index(n) for n in FITTED_TIMING])

@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tuning._events import LOWER_BOUND_STYLES, STYLE_METRIC, EventSetup, collisions_rise, event_metrics
+from footfall.tuning._events import LOWER_BOUND_STYLES, STYLE_METRIC, EventSetup, collisions_rise, event_metrics
 
 MATRIX_FILE = Path(__file__).resolve().parent / "data" / "matrix.json"
 TERRAINS = {
@@ -100,7 +100,7 @@ def _paired(a: dict, b: dict, key: str, sign: float) -> dict:
 
 def style_of(name: str) -> dict:
     """The style (key -> bound) of a style preset, from its targets file; {} for a terrain preset."""
-    from tuning._targets import load_tune_targets
+    from footfall.tuning._targets import load_tune_targets
 
     spec = PRESETS[name]
     if "style" not in spec:
@@ -166,8 +166,8 @@ def run_matrix(presets_dir: str | Path, names=None, runs: int = RUNS, terrains=N
                progress=None) -> dict:
     """Every preset of ``names`` (default: :data:`PRESETS`) found in ``presets_dir`` (``NAME.json``)
     against the defaults on ``terrains`` (default: :data:`TERRAINS`); the matrix (JSON-ready)."""
-    from planner import ScoringWeights, load_preset
-    from tuning._targets import load_tune_targets
+    from footfall.planner import ScoringWeights, load_preset
+    from footfall.tuning._targets import load_tune_targets
 
     names = tuple(names or PRESETS)
     terrains = tuple(terrains or TERRAINS)

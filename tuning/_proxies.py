@@ -67,8 +67,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from planner import GRAVITY, SWING_MAX, SWING_MIN, duty_law, stride_law
-from planner.layout import (
+from footfall.planner import GRAVITY, SWING_MAX, SWING_MIN, duty_law, stride_law
+from footfall.planner.layout import (
     FEAT_DISTANCE,
     FEAT_PROXIMITY,
     FEAT_ROUGHNESS,
@@ -89,8 +89,8 @@ from planner.layout import (
     T_STRIDE_COEFFICIENT,
     T_STRIDE_EXPONENT,
 )
-from tuning._config import enable_x64
-from tuning._scoring import couple_score
+from footfall.tuning._config import enable_x64
+from footfall.tuning._scoring import couple_score
 
 LEAST_FREQUENCY_HZ = 1e-3
 """The crowd divides by max(f, 1e-3) (planner._crowd.stage_plan)."""

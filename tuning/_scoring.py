@@ -24,8 +24,8 @@ from __future__ import annotations
 
 import jax.numpy as jnp
 
-from planner import falling_goodness, rational_goodness, rising_goodness
-from planner.layout import (
+from footfall.planner import falling_goodness, rational_goodness, rising_goodness
+from footfall.planner.layout import (
     FEAT_DISTANCE,
     FEAT_LEG_GAP,
     FEAT_PROXIMITY,

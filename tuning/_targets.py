@@ -131,7 +131,7 @@ class CreatureTargets:
         then commands the target law, and its per-stride error is measured against it."""
         import dataclasses
 
-        from planner import GaitTiming
+        from footfall.planner import GaitTiming
 
         c, e = self.stride_law
         return dataclasses.replace(base or GaitTiming(), stride_coefficient=c, stride_exponent=e)
@@ -200,8 +200,8 @@ def load_targets(path: str | Path = TARGETS_FILE, creatures=None) -> dict[str, C
 
 def _whole_targets(data: dict, file: str, creatures) -> dict[str, CreatureTargets]:
     """:func:`load_targets` of a whole targets file's parsed ``data`` (``file`` names it in errors)."""
-    from planner import hip_height
-    from scenarios import builtin_creature_names, load_creature
+    from footfall.planner import hip_height
+    from footfall.scenarios import builtin_creature_names, load_creature
 
     for key in data:
         if key not in ("schema_version", "sources", "defaults", "creatures"):
@@ -270,7 +270,7 @@ def load_tune_targets(path: str | Path | None, creature: str) -> CreatureTargets
     """The targets of one creature for ``footfall tune``: the shipped ones (``path`` None), a whole
     targets file (one with ``[defaults]``), or a user's file laid over the shipped ones (module
     docstring). A malformed file is refused with an :class:`InputError` naming it and the field."""
-    from scenarios import load_creature
+    from footfall.scenarios import load_creature
 
     name = load_creature(creature).name
     if path is None:

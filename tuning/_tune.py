@@ -3,7 +3,7 @@
 Each outer round r (``rounds`` at most):
 
 1. **harvest** candidate sets with the exact planner under the current parameters
-   (``planner.harvest_situations``, seed ``seed + r``), on the harvest scenarios with the
+   (``footfall.tuning.harvest_situations``, seed ``seed + r``), on the harvest scenarios with the
    crowd speed set to each speed of the sweep (:func:`speed_variant`: the stride target
    depends on speed, one speed would leave the timing's exponent unidentified);
 2. **fit** (:func:`tuning._fit.fit`: optimistix Levenberg-Marquardt, log-parametrised,
@@ -73,7 +73,7 @@ import numpy as np
 
 from footfall._atomic import make_folder, write_text_atomic
 from footfall._errors import InputError
-from tuning._exact import JERK_GUARD, ExactSetup, exact_metrics, speeds_for
+from footfall.tuning._exact import JERK_GUARD, ExactSetup, exact_metrics, speeds_for
 
 CHECKPOINT_FORMAT = "footfall-tune-checkpoint"
 CHECKPOINT_VERSION = 3
@@ -164,8 +164,8 @@ class TuneConfig:
 
     def start(self):
         """The ``GaitTiming`` the search starts from: the defaults with ``start_timing`` applied."""
-        from planner import GaitTiming
-        from planner.layout import TIMING_FIELDS
+        from footfall.planner import GaitTiming
+        from footfall.planner.layout import TIMING_FIELDS
 
         try:
             pairs = dict((str(name), float(value)) for name, value in self.start_timing)
@@ -213,7 +213,7 @@ class TuneResult:
 def check_creature(name: str) -> str:
     """``name`` if it is a built-in creature name or a creature ``.toml`` (one resolver:
     :func:`scenarios.load_creature`); else one line on ``--creature``."""
-    from scenarios import load_creature
+    from footfall.scenarios import load_creature
 
     try:
         load_creature(name)
@@ -254,20 +254,20 @@ def _params(weights, timing) -> dict:
 
 def _start_params(config: TuneConfig) -> dict:
     """The default weights and ``config.start()``'s timing: where the search begins."""
-    from planner import ScoringWeights
+    from footfall.planner import ScoringWeights
 
     return _params(ScoringWeights().to_array(), config.start().to_array())
 
 
 def _default_params() -> dict:
     """The runtime's defaults (the start when ``start_timing`` is empty)."""
-    from planner import GaitTiming, ScoringWeights
+    from footfall.planner import GaitTiming, ScoringWeights
 
     return _params(ScoringWeights().to_array(), GaitTiming().to_array())
 
 
 def _objects(params: dict):
-    from planner import GaitTiming, ScoringWeights
+    from footfall.planner import GaitTiming, ScoringWeights
 
     return (ScoringWeights.from_array(np.asarray(params["weights"], dtype=np.float64)),
             GaitTiming.from_array(np.asarray(params["timing"], dtype=np.float64)))
@@ -285,7 +285,7 @@ def _pad_problem(problem, n: int, k: int, s: int):
     Padded situations have one dummy couple (a finite softmax) and are masked out of every block."""
     import jax.numpy as jnp
 
-    from tuning._proxies import Situations
+    from footfall.tuning._proxies import Situations
 
     sit = problem.situations
     f, k0, s0 = (int(x) for x in sit.couple_mask.shape)
@@ -344,7 +344,7 @@ def _bucket(x: int, step: int) -> int:
 def _by_froude(exact: dict, leg_height: float, value) -> list[tuple[float, float]]:
     """(mean realised Fr, mean value(run)) per Froude number of the sweep, sorted; runs where
     ``value`` is None or the pelvis did not move are left out."""
-    from planner import GRAVITY
+    from footfall.planner import GRAVITY
 
     groups: dict[float, list[tuple[float, float]]] = {}
     for run in exact["runs"]:
@@ -384,7 +384,7 @@ def speed_variant(name: str, speed: float) -> str:
     set to ``speed`` (m/s), as a variant string (``scenarios.split_variant``): ``harvest_situations``
     runs every crowd at its scenario's speed, and the fit needs the sweep's speeds. A plain string,
     so a harvest task loads the same scenario on any worker."""
-    from scenarios import variant_name
+    from footfall.scenarios import variant_name
 
     base, sep, rest = name.partition("@")
     extra = variant_name("", crowd__speed=float(speed))[1:]
@@ -392,7 +392,7 @@ def speed_variant(name: str, speed: float) -> str:
 
 
 def _harvest(config: TuneConfig, params: dict, seed: int, map_tasks=None):
-    from planner import harvest_situations
+    from footfall.tuning._harvest_runs import harvest_situations
 
     weights, timing = _objects(params)
     speeds = speeds_for(config.exact_setup())
@@ -404,9 +404,9 @@ def _harvest(config: TuneConfig, params: dict, seed: int, map_tasks=None):
 
 def _fit_round(config: TuneConfig, params: dict, exact_current: dict, round_index: int, targets, map_tasks=None):
     """Harvest under ``params``, fit; returns (new params, fit record)."""
-    from planner import GRAVITY
-    from tuning._fit import fit, initial_params, loss, make_problem
-    from tuning._proxies import situations_from_harvest
+    from footfall.planner import GRAVITY
+    from footfall.tuning._fit import fit, initial_params, loss, make_problem
+    from footfall.tuning._proxies import situations_from_harvest
 
     harvest = _harvest(config, params, config.seed + round_index, map_tasks)
     situations = situations_from_harvest(harvest)
@@ -434,7 +434,7 @@ def spearman_proxy_exact(config: TuneConfig, params: dict, map_tasks=None) -> tu
     import jax.numpy as jnp
     from scipy.stats import spearmanr
 
-    from tuning._proxies import couple_scores, situations_from_harvest
+    from footfall.tuning._proxies import couple_scores, situations_from_harvest
 
     harvest = _harvest(config, params, config.seed + 1000, map_tasks)
     situations = situations_from_harvest(harvest)
@@ -568,10 +568,10 @@ def tune(config: TuneConfig, out: str | Path, resume: bool = False, progress=Non
 
 
 def _tune(config: TuneConfig, out, resume, progress, stop_after, write, evaluate, map_tasks, t0) -> TuneResult:
-    from planner import preset_dict
-    from scenarios import default_gait_name, load_creature
-    from tuning._config import enable_x64
-    from tuning._targets import TARGETS_FILE, load_targets
+    from footfall.planner import preset_dict
+    from footfall.scenarios import default_gait_name, load_creature
+    from footfall.tuning._config import enable_x64
+    from footfall.tuning._targets import TARGETS_FILE, load_targets
 
     out = check_output(out)
     ckpt = checkpoint_path(out)

@@ -7,7 +7,7 @@ law the per-stride error is measured against):
 
 Each outer round r (``rounds`` at most):
 
-1. **harvest** every couple the search could pick (``planner.harvest_situations``, seed ``seed + r``)
+1. **harvest** every couple the search could pick (``footfall.tuning.harvest_situations``, seed ``seed + r``)
    on the training scenarios, each spawned :data:`HARVEST_SPAWN` of the way along its route so the
    situations meet the feature (risers, crates, slopes);
 2. **fit** the weights alone (:func:`tuning._fit.fit` with the weights' blocks, ``fit_timing=False``,
@@ -39,9 +39,9 @@ import numpy as np
 
 from footfall._atomic import write_text_atomic
 from footfall._errors import InputError
-from tuning._events import (EVENT_FRAMES, SPAWN_FRACTIONS, EventSetup, collisions_rise, event_metrics, paired,
+from footfall.tuning._events import (EVENT_FRAMES, SPAWN_FRACTIONS, EventSetup, collisions_rise, event_metrics, paired,
                             spawn_variant)
-from tuning._tune import (LINE_SEARCH, TuneResult, _bucket, _floats, _objects, _pad_problem, _towards, check_creature,
+from footfall.tuning._tune import (LINE_SEARCH, TuneResult, _bucket, _floats, _objects, _pad_problem, _towards, check_creature,
                           check_output, checkpoint_path)
 
 CHECKPOINT_FORMAT = "footfall-tune-events-checkpoint"
@@ -144,7 +144,7 @@ class EventTuneConfig:
 
 def check_scenarios(names) -> tuple[str, ...]:
     """Every scenario loads (one line on the first that does not)."""
-    from scenarios import load_scenario
+    from footfall.scenarios import load_scenario
 
     names = tuple(n.strip() for n in names if n.strip())
     if not names:
@@ -155,7 +155,7 @@ def check_scenarios(names) -> tuple[str, ...]:
 
 
 def _start(targets) -> dict:
-    from planner import ScoringWeights
+    from footfall.planner import ScoringWeights
 
     return {"weights": _floats(ScoringWeights().to_array()), "timing": _floats(targets.timing().to_array())}
 
@@ -174,7 +174,7 @@ def style_start(params: dict, targets) -> dict:
     both 0.9 %. The fit moves the weights on from there (its gradient for the proximity weight stays
     small: one term of ten, for the few footprints near a box); every candidate is judged against the
     defaults' runs, and the preset's change is measured from the defaults."""
-    from planner.layout import W_PROXIMITY_REF
+    from footfall.planner.layout import W_PROXIMITY_REF
 
     bound = targets.style.get("min_clearance_body_heights") if targets.style else None
     if bound is None:
@@ -185,9 +185,9 @@ def style_start(params: dict, targets) -> dict:
 
 
 def _fit_round(config: EventTuneConfig, params: dict, round_index: int, targets, map_tasks):
-    from planner import harvest_situations
-    from tuning._fit import fit, initial_params, loss, make_problem
-    from tuning._proxies import situations_from_harvest
+    from footfall.tuning._harvest_runs import harvest_situations
+    from footfall.tuning._fit import fit, initial_params, loss, make_problem
+    from footfall.tuning._proxies import situations_from_harvest
 
     weights, timing = _objects(params)
     scenarios = tuple(spawn_variant(n, HARVEST_SPAWN) for n in config.scenarios)
@@ -285,10 +285,10 @@ def tune_events(config: EventTuneConfig, out, resume: bool = False, progress=Non
 
 def _run(config, out, resume, progress, stop_after, write, map_tasks, t0, spearman_candidates,
          evaluate=True) -> TuneResult:
-    from planner import preset_dict
-    from scenarios import default_gait_name, load_creature
-    from tuning._config import enable_x64
-    from tuning._targets import load_tune_targets
+    from footfall.planner import preset_dict
+    from footfall.scenarios import default_gait_name, load_creature
+    from footfall.tuning._config import enable_x64
+    from footfall.tuning._targets import load_tune_targets
 
     enable_x64()
     targets = load_tune_targets(config.targets_file, config.creature)
@@ -352,7 +352,7 @@ def _run(config, out, resume, progress, stop_after, write, map_tasks, t0, spearm
         held_tuned, gain, se = held_default, 0.0, math.nan
     spearman = None
     if spearman_candidates > 0:
-        from tuning._validate import metric_change_spearman
+        from footfall.tuning._validate import metric_change_spearman
 
         say("proxy validation", total - 1, total)
         spearman = metric_change_spearman(config, targets, spearman_candidates, map_tasks)

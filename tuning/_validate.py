@@ -40,8 +40,8 @@ UNMOVED = {"curvature_p95": 1e-9}
 
 def candidate_weights(n: int, seed: int) -> list[np.ndarray]:
     """``n`` weight vectors (ScoringWeights.to_array()) around the defaults (module docstring)."""
-    from planner import ScoringWeights
-    from planner.layout import N_TERMS
+    from footfall.planner import ScoringWeights
+    from footfall.planner.layout import N_TERMS
 
     rng = np.random.default_rng(seed)
     base = ScoringWeights().to_array()
@@ -58,11 +58,12 @@ def metric_change_spearman(config, targets, n: int, map_tasks=None) -> dict:
     import jax.numpy as jnp
     from scipy.stats import spearmanr
 
-    from planner import ScoringWeights, harvest_situations
-    from tuning._config import enable_x64
-    from tuning._events import CLEARANCE_CAP_H, event_metrics, spawn_variant
-    from tuning._proxies import expected_metrics, situations_from_harvest
-    from tuning._tune_events import HARVEST_SPAWN
+    from footfall.planner import ScoringWeights
+    from footfall.tuning._harvest_runs import harvest_situations
+    from footfall.tuning._config import enable_x64
+    from footfall.tuning._events import CLEARANCE_CAP_H, event_metrics, spawn_variant
+    from footfall.tuning._proxies import expected_metrics, situations_from_harvest
+    from footfall.tuning._tune_events import HARVEST_SPAWN
 
     enable_x64()
     if n < 3:

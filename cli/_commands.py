@@ -55,7 +55,7 @@ def _err() -> Console:
 
 
 def _budget(name: str):
-    from planner import DEFAULT_BUDGET, EXHAUSTIVE, FIRST_VALID
+    from footfall.planner import DEFAULT_BUDGET, EXHAUSTIVE, FIRST_VALID
 
     budgets = dict(zip(BUDGET_NAMES, (FIRST_VALID, DEFAULT_BUDGET, EXHAUSTIVE)))
     if name not in budgets:
@@ -81,11 +81,11 @@ def scenarios_cmd() -> None:
     """List the built-in scenarios, creatures and gaits, with what each one is."""
     import tomllib
 
-    from scenarios import (DEFAULT_SCENARIO, builtin_creature_names, builtin_scenario_names, load_creature, load_gait,
+    from footfall.scenarios import (DEFAULT_SCENARIO, builtin_creature_names, builtin_scenario_names, load_creature, load_gait,
                            load_scenario)
-    from scenarios._files import CREATURES_DIR
-    from scenarios._gait_schedule import BUILTIN_SCHEDULES
-    from scenarios._gaits import builtin_gait_names, default_gait_name
+    from footfall.scenarios._files import CREATURES_DIR
+    from footfall.scenarios._gait_schedule import BUILTIN_SCHEDULES
+    from footfall.scenarios._gaits import builtin_gait_names, default_gait_name
 
     lines = ["Scenarios (footfall run|simulate|report|... NAME, or a .toml; NAME@key=value for a variant):"]
     for name in builtin_scenario_names():
@@ -131,11 +131,11 @@ def check_cmd(
     A problem is one line naming the file, the field and the reason, with exit code 2; warnings \
 (e.g. legs whose rest feet could cross) go to stderr with exit code 0.
     """
-    from footfall._runs import duty_factor_note, resolve_gait
-    from scenarios import load_creature, load_gait, load_scenario
-    from scenarios._creatures import leg_crossing_warnings
-    from scenarios._files import file_kind
-    from scenarios._gaits import min_stance_feet
+    from footfall.scenarios._gait_choice import duty_factor_note, resolve_gait
+    from footfall.scenarios import load_creature, load_gait, load_scenario
+    from footfall.scenarios._creatures import leg_crossing_warnings
+    from footfall.scenarios._files import file_kind
+    from footfall.scenarios._gaits import min_stance_feet
 
     if speed is not None and not (math.isfinite(speed) and speed > 0):
         raise InputError("argument", "--speed", f"expected a positive number of m/s, got {speed}")
@@ -188,9 +188,9 @@ def plan_cmd(
     """Plan one step of every foot of a creature standing at the scenario's spawn point."""
     import numpy as np
 
-    from planner import WorldRaster, plan_foot, planner_config_for
-    from planner._situations import stand, step_queries
-    from scenarios import load_creature, load_scenario
+    from footfall.planner import WorldRaster, plan_foot, planner_config_for
+    from footfall.planner._situations import stand, step_queries
+    from footfall.scenarios import load_creature, load_scenario
 
     s = load_scenario(scenario)
     c = load_creature(creature or s.crowd.creature)
@@ -247,8 +247,10 @@ def simulate_cmd(
     """Simulate a crowd walking through a scenario and report what happened."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
-    from footfall._runs import load_named_preset, recorded_run, recording_meta, resolve_gait, say_duty_factor
-    from scenarios import load_creature, load_scenario
+    from footfall.cli._named_preset import load_named_preset
+    from footfall.reports._runs import recorded_run, recording_meta
+    from footfall.scenarios._gait_choice import resolve_gait, say_duty_factor
+    from footfall.scenarios import load_creature, load_scenario
 
     s = load_scenario(scenario)
     c = load_creature(creature or s.crowd.creature)
@@ -314,8 +316,8 @@ violations and the exact command that replays each of the worst runs.
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
     from footfall._distribute import check_workers
-    from reports._evaluate import draw_seeds, evaluate, picture_png, run_one, table_rows, write_outputs
-    from scenarios import builtin_creature_names, builtin_scenario_names, load_creature, load_scenario
+    from footfall.reports._evaluate import draw_seeds, evaluate, picture_png, run_one, table_rows, write_outputs
+    from footfall.scenarios import builtin_creature_names, builtin_scenario_names, load_creature, load_scenario
 
     for option, value in (("--seeds", seeds), ("--characters", characters), ("--frames", frames)):
         if value < 1:
@@ -384,8 +386,8 @@ def run_cmd(
     Progress goes to stderr: a live line on a terminal, else one line every few seconds with the \
 step and the elapsed time.
     """
-    from footfall._mainjob import STEPS, run_main_job
-    from footfall._progress import Progress
+    from footfall.cli._mainjob import STEPS, run_main_job
+    from footfall.cli._progress import Progress
 
     with Progress("footfall run", enabled=not json_out) as bar:
 
@@ -441,9 +443,9 @@ footprints. The crowd is the scenario's (its size unless --characters).
 
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
-    from reports._recording import load_recording
-    from reports._usd import check_output_path, export_usd
-    from scenarios import load_creature, load_scenario
+    from footfall.reports._recording import load_recording
+    from footfall.reports._usd import check_output_path, export_usd
+    from footfall.scenarios import load_creature, load_scenario
 
     out_path = check_output_path(out)
     if recording is not None:
@@ -458,7 +460,9 @@ footprints. The crowd is the scenario's (its size unless --characters).
         if frames is not None:
             run = run.head(frames)
     else:
-        from footfall._runs import load_named_preset, recorded_run, recording_meta, resolve_gait, say_duty_factor
+        from footfall.cli._named_preset import load_named_preset
+        from footfall.reports._runs import recorded_run, recording_meta
+        from footfall.scenarios._gait_choice import resolve_gait, say_duty_factor
 
         frames = frames or 90
         seed = seed or 0
@@ -501,7 +505,7 @@ def report_cmd(
     """Evaluation sweep (scenarios x LOD settings x crowd sizes): cost, quality, plots, renders, index.html."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
-    from reports._report import build_report
+    from footfall.reports._report import build_report
 
     if quick and full:
         raise InputError("argument", "--quick/--full", "choose one of --quick and --full")
@@ -604,9 +608,9 @@ meet the terrain, checked on held-out variants (a terrain or style preset).
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
     from footfall._distribute import check_workers
-    from tuning._tune import TuneConfig, check_creature, check_output, tune
+    from footfall.tuning._tune import TuneConfig, check_creature, check_output, tune
 
-    from scenarios import load_creature
+    from footfall.scenarios import load_creature
 
     check_workers(workers, cluster)
     check_creature(creature)
@@ -615,8 +619,8 @@ meet the terrain, checked on held-out variants (a terrain or style preset).
         raise InputError("argument", "--rounds", f"expected an integer >= 1, got {rounds}")
     events = scenarios is not None or targets is not None
     if events:
-        from tuning._targets import load_tune_targets
-        from tuning._tune_events import DEFAULT_SCENARIOS, EventTuneConfig, check_scenarios, tune_events
+        from footfall.tuning._targets import load_tune_targets
+        from footfall.tuning._tune_events import DEFAULT_SCENARIOS, EventTuneConfig, check_scenarios, tune_events
 
         if start_timing:
             raise InputError("argument", "--start-timing", "tunes the timing; --scenarios/--targets tune the weights")
@@ -665,7 +669,7 @@ def bench_crowd_cmd(
 ) -> None:
     """The paper's Table 1: ms per frame, maps preparation, CCD IK and FPS per LOD mode, measured
     interleaved (the modes share the machine's load), and LOD on / LOD off per crowd size."""
-    from benchmarks.crowd_bench import SIZES, run
+    from footfall.benchmarks.crowd_bench import SIZES, run
 
     sizes = (characters,) if characters else SIZES
     with _err().status("benchmarking crowds...") as status:
@@ -703,13 +707,13 @@ def bench_tuning_cmd(
 
     Wall time and exact evaluations to reach the same exact loss.
     """
-    from benchmarks.tuning_bench import run, run_events, table
-    from tuning._tune import check_creature
+    from footfall.benchmarks.tuning_bench import run, run_events, table
+    from footfall.tuning._tune import check_creature
 
     check_creature(creature)
     with _err().status("benchmarking the tuning...") as status:
         if scenarios is not None:
-            from tuning._tune_events import check_scenarios
+            from footfall.tuning._tune_events import check_scenarios
 
             result = run_events(creature, check_scenarios(scenarios.split(",")), seed=seed, max_evals=max_evals,
                                 rounds=max(rounds, 1), progress=lambda m: status.update(f"benchmarking: {m}"))
@@ -743,7 +747,7 @@ elsewhere; a style preset with its style metric >= 2 SE toward its bound; neithe
     """
     from footfall._atomic import write_text_atomic
     from footfall._distribute import check_workers, task_runner
-    from tuning._matrix import PRESETS, run_matrix
+    from footfall.tuning._matrix import PRESETS, run_matrix
 
     check_workers(workers, cluster)
     chosen = tuple(n.strip() for n in names.split(",") if n.strip()) if names else tuple(PRESETS)
@@ -816,7 +820,7 @@ def bench_planner_cmd(
     repeats: int = typer.Option(3, min=1, help="Runs per measurement (the best is kept)"),
 ) -> None:
     """Median microseconds per foot plan on crates and mixed, and the shared wavefront's speedup."""
-    from benchmarks.planner_bench import run
+    from footfall.benchmarks.planner_bench import run
 
     err = _err()
     with err.status("benchmarking the planner...") as status:
@@ -867,7 +871,7 @@ def usage_error(error: click_exceptions.UsageError) -> InputError:
         field = _option_name(error.param) if error.param is not None else "argument"
         cause = error.__cause__
         if isinstance(cause, ValidationError):
-            from scenarios._schema import pydantic_reason
+            from footfall.scenarios._schema import pydantic_reason
 
             first = cause.errors(include_url=False)[0]
             return InputError("argument", field, f"{pydantic_reason(first)}, got {first.get('input')}")
@@ -941,7 +945,7 @@ def render_cmd(
 
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
-    from reports._animation import (DEFAULT_SIMULATED_FRAMES, RenderError, check_clip_options, recording_clip_scene,
+    from footfall.reports._animation import (DEFAULT_SIMULATED_FRAMES, RenderError, check_clip_options, recording_clip_scene,
                                     render_clip)
 
     out_path = check_clip_options(out, frames, camera, width, height)
@@ -953,8 +957,9 @@ def render_cmd(
     try:
         with tempfile.TemporaryDirectory(prefix="footfall-render-") as folder:
             if recording is None:
-                from footfall._runs import recorded_run, recording_meta, resolve_gait, say_duty_factor
-                from scenarios import load_creature, load_scenario
+                from footfall.reports._runs import recorded_run, recording_meta
+                from footfall.scenarios._gait_choice import resolve_gait, say_duty_factor
+                from footfall.scenarios import load_creature, load_scenario
 
                 s = load_scenario(scenario or "mixed")
                 c = load_creature(s.crowd.creature)
@@ -1009,7 +1014,3 @@ def main(argv: list[str] | None = None) -> None:
         # Argument validation in the libraries names the argument in its message.
         _fail(f"argument: {e}")
     sys.exit(code if isinstance(code, int) else 0)
-
-
-if __name__ == "__main__":
-    main()

@@ -50,13 +50,14 @@ def run_main_job(scenario_name: str, out_dir, *, seed: int = 0, quick: bool = Fa
     ``quick``: a short simulation, one tuning round and the report's quick sweep (tests).
     ``progress(step, message)`` is called as the job advances.
     """
-    from footfall._runs import recorded_run, recording_meta, resolve_gait, say_duty_factor
-    from planner._presets import load_preset
-    from reports._recording import load_recording
-    from reports._report import CLIP_MAX_FRAMES, build_report
-    from reports._usd import export_usd
-    from scenarios import DEFAULT_SCENARIO, load_creature, load_scenario
-    from tuning._tune import TuneConfig, check_creature, tune
+    from footfall.reports._runs import recorded_run, recording_meta
+    from footfall.scenarios._gait_choice import resolve_gait, say_duty_factor
+    from footfall.planner._presets import load_preset
+    from footfall.reports._recording import load_recording
+    from footfall.reports._report import CLIP_MAX_FRAMES, build_report
+    from footfall.reports._usd import export_usd
+    from footfall.scenarios import DEFAULT_SCENARIO, load_creature, load_scenario
+    from footfall.tuning._tune import TuneConfig, check_creature, tune
 
     progress = progress or (lambda step, message: None)
     scenario = load_scenario(scenario_name)

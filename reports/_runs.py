@@ -1,0 +1,43 @@
+"""One recorded crowd run: the piece ``simulate``, ``export-usd``, ``evaluate``, the report and the main
+job share."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+
+def recorded_run(scenario, creature, gait, *, frames: int, characters: int | None = None, seed: int = 0,
+                 preset=None, lod: str = "off", record: bool = True, progress=None):
+    """Simulate ``frames`` frames of the scenario's crowd; returns (model, summary, recorder or None).
+
+    ``preset``: a loaded :class:`planner.Preset` (its weights and timing), or None for the defaults.
+    ``progress(k)`` is called after frame k.
+    """
+    from footfall.planner._crowd import init_crowd
+    from footfall.planner._simulation import Recorder, simulate
+
+    weights = preset.weights if preset is not None else None
+    timing = preset.timing if preset is not None else None
+    model, state = init_crowd(scenario, creature, gait, n_characters=characters, seed=seed, weights=weights,
+                              timing=timing, lod_mode=lod)
+    recorder = Recorder(model, state, frames) if record else None
+    say_speed_cap(model)
+    summary = simulate(model, state, frames, recorder, progress=progress)
+    return model, summary, recorder
+
+
+def say_speed_cap(model) -> None:
+    """One note on stderr when the creature's legs cannot carry the asked speed (the controller caps it)."""
+    import sys
+
+    if model.speed_asked > model.speed_cap:
+        print(f"footfall: note: {model.creature.name}: {model.speed_asked:g} m/s asked; speed capped at "
+              f"{model.speed_cap:.3g} m/s, the fastest its legs carry at the stride law", file=sys.stderr)
+
+
+def recording_meta(scenario, seed: int, lod: str, gait) -> dict:
+    """What a recording's header says about its run, beside the recorder's own fields."""
+    meta = {"scenario": scenario.name, "seed": int(seed), "lod": lod, "gait": gait.name}
+    if not scenario.source.startswith("builtin:"):  # a user's scenario file: where to find it again
+        meta["scenario_file"] = str(Path(scenario.source).resolve())
+    return meta
