@@ -198,7 +198,7 @@ def exact_loss_of(setup, targets, x, start=None) -> tuple[float, str | None]:
     except ValueError as e:
         return INVALID_LOSS, f"invalid parameters: {e}"
     try:
-        loss = float(exact_metrics(setup, weights, timing, targets=targets)["exact_loss"])
+        loss = float(exact_metrics(setup, weights, timing, targets=targets).exact_loss)
     except (RuntimeError, ValueError, FloatingPointError) as e:
         return INVALID_LOSS, f"exact run failed: {e}"
     if not math.isfinite(loss):

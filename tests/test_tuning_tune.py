@@ -3,6 +3,7 @@ a killed run resumed gives the same bytes (in-process: that local workers harves
 runs as the process does is test_distributed_tuning's; the main job tunes on them), shipped presets load
 for their creature only, and what the shipped presets do on held-out runs."""
 
+import dataclasses
 import json
 from pathlib import Path
 
@@ -103,6 +104,12 @@ def test_bad_checkpoints_and_arguments_are_refused(tiny_runs, tmp_path):
         tune(config, bad, resume=True, workers=1)
     with pytest.raises(InputError, match="other settings"):
         tune(_tiny(seed=3), folder / "whole.json", resume=True, workers=1)
+    # A checkpoint whose metrics lost a field: refused, naming the section and the field.
+    data = json.loads(checkpoint_path(folder / "whole.json").read_text())
+    del data["start_exact"]["jerk_median"]
+    checkpoint_path(tmp_path / "broken.json").write_text(json.dumps(data))
+    with pytest.raises(InputError, match="start_exact: corrupt checkpoint: exact metrics: jerk_median: missing field"):
+        tune(config, tmp_path / "broken.json", resume=True, workers=1)
     with pytest.raises(InputError, match="--creature"):
         tune(_tiny().__class__("octopus"), tmp_path / "o.json", workers=1)
 
@@ -159,10 +166,10 @@ def test_the_spider_preset_numbers_are_reproduced_live_and_stay_safe():
     tuned = exact_metrics(setup, preset.weights, preset.timing)
     default = exact_metrics(setup)
     stored = preset.provenance["losses"]
-    assert tuned["stride_ratio"][0] == stored["heldout_tuned"]["stride_ratio"][0]
-    assert default["stride_ratio"][0] == stored["heldout_default"]["stride_ratio"][0]
-    assert tuned["collisions"] == 0 and stored["heldout_tuned"]["collisions"] == 0
-    assert tuned["curvature_energy_mean"] <= default["curvature_energy_mean"] + CURVATURE_SLACK
+    assert tuned.stride_ratio[0] == stored["heldout_tuned"]["stride_ratio"][0]
+    assert default.stride_ratio[0] == stored["heldout_default"]["stride_ratio"][0]
+    assert tuned.collisions == 0 and stored["heldout_tuned"]["collisions"] == 0
+    assert tuned.curvature_energy_mean <= default.curvature_energy_mean + CURVATURE_SLACK
     assert stored["tuned"]["stride_rel_error"] <= stored["default"]["stride_rel_error"]  # on the runs it was fit to
 
 
@@ -226,7 +233,7 @@ def test_a_tuned_preset_that_walks_worse_on_the_held_out_runs_is_not_shipped(tmp
     def exact_metrics(setup, weights=None, timing=None, **kwargs):
         m = real(setup, weights, timing, **kwargs)
         if setup == held_out and weights != ScoringWeights():
-            m = dict(m, stride_rel_error=m["stride_rel_error"] + 0.5)
+            m = dataclasses.replace(m, stride_rel_error=m.stride_rel_error + 0.5)
         return m
 
     monkeypatch.setattr(tune_module, "_accept", lambda *args, **kwargs: (True, "improved"))
@@ -239,10 +246,33 @@ def test_a_tuned_preset_that_walks_worse_on_the_held_out_runs_is_not_shipped(tmp
     assert losses["heldout_tuned"] == losses["heldout_default"]
 
 
-def _metrics(run_losses, exact_loss):
-    return {"finite": True, "collisions": 0, "curvature_energy_mean": 0.0, "curvature_energy_se": 0.0,
-            "jerk_median": 1.0, "exact_loss": exact_loss, "stride_rel_error": 0.01,
-            "runs": [{"run_loss": x} for x in run_losses]}
+def _metrics(run_losses, exact_loss, **changes):
+    """Exact metrics with the given per-run losses and loss (the other fields: a clean run's)."""
+    from footfall.tuning._exact import ExactMetrics, ExactRun
+
+    runs = tuple(ExactRun(scenario="flat", seed=0, froude=0.01, run_loss=x, desired_speed=0.1, realised_speed=0.1,
+                          strides=4, stride_ratio=1.0, commanded_ratio=1.0, duty_factor=0.6, commanded_duty=0.6,
+                          collisions=0) for x in run_losses)
+    metrics = ExactMetrics(exact_loss=exact_loss, stride_rel_error=0.01, stride_ratio=(1.0,), stride_term=0.0,
+                           duty_term=0.0, curvature_energy_mean=0.0, curvature_energy_se=0.0, curvature_term=0.0,
+                           clearance_mean_m=0.01, clearance_term=0.0, jerk_median=1.0, collisions=0, finite=True,
+                           plans=1, leg_height_m=0.1, runs=runs)
+    return dataclasses.replace(metrics, **changes)
+
+
+def test_exact_metrics_round_trip_through_json_and_name_a_bad_field():
+    from footfall.tuning._exact import ExactMetrics
+
+    metrics = _metrics([1.0, 2.0], 1.5, stride_ratio=(0.9, 1.1))
+    data = json.loads(json.dumps(metrics.to_json()))
+    assert list(data) == [f.name for f in dataclasses.fields(ExactMetrics)] and data["runs"][1]["run_loss"] == 2.0
+    assert ExactMetrics.from_json(data) == metrics
+    with pytest.raises(ValueError, match="jerk_median: missing field"):
+        ExactMetrics.from_json({k: v for k, v in data.items() if k != "jerk_median"})
+    with pytest.raises(ValueError, match="bogus: unknown field"):
+        ExactMetrics.from_json(dict(data, bogus=1))
+    with pytest.raises(ValueError, match=r"runs\[0\]"):
+        ExactMetrics.from_json(dict(data, runs=[{"run_loss": 1.0}]))
 
 
 def test_a_candidate_must_beat_the_best_by_more_than_the_runs_noise():
@@ -271,11 +301,11 @@ def test_guards_allow_the_higher_of_the_defaults_and_a_mis_tuned_start():
     from footfall.tuning._tune import JERK_GUARD, _accept
 
     default = _metrics([1.0, 2.0, 3.0], 1.0)
-    start = dict(_metrics([3.0, 4.0, 5.0], 4.0), jerk_median=2.0)
-    mended = dict(_metrics([0.5, 1.5, 2.5], 0.5), jerk_median=1.5)
-    assert 1.5 > (1.0 + JERK_GUARD) * default["jerk_median"]
+    start = _metrics([3.0, 4.0, 5.0], 4.0, jerk_median=2.0)
+    mended = _metrics([0.5, 1.5, 2.5], 0.5, jerk_median=1.5)
+    assert 1.5 > (1.0 + JERK_GUARD) * default.jerk_median
     assert _accept(mended, start, default, gain_noise_se=0.0)[0] is False
     assert _accept(mended, start, default, gain_noise_se=0.0, start=start) == (True, "improved")
-    worse = dict(mended, jerk_median=2.5)
+    worse = dataclasses.replace(mended, jerk_median=2.5)
     accepted, why = _accept(worse, start, default, gain_noise_se=0.0, start=start)
     assert not accepted and "jerk" in why

@@ -225,8 +225,75 @@ def run_exact_task(task: dict) -> dict:
     return r
 
 
-def exact_metrics(setup: ExactSetup, weights=None, timing=None, targets=None, map_tasks=None) -> dict:
-    """Run the sweep and return the exact loss with its parts (plain numbers, JSON-ready).
+@dataclass(frozen=True)
+class ExactRun:
+    """One run of the sweep (a scenario x seed x speed), measured: the per-run parts of the loss."""
+
+    scenario: str
+    seed: int
+    froude: float  # the sweep's Froude number (the asked speed's)
+    run_loss: float  # this run's share of the loss's per-run terms (tuning._tune compares candidates run by run)
+    desired_speed: float  # m/s
+    realised_speed: float  # m/s, the pelvis's mean over the measured frames
+    strides: int
+    stride_ratio: float | None  # mean stride / mean target stride (None: no stride measured)
+    commanded_ratio: float | None  # mean stride / mean commanded stride
+    duty_factor: float  # realised stance fraction
+    commanded_duty: float | None
+    collisions: int
+
+
+@dataclass(frozen=True)
+class ExactMetrics:
+    """The exact loss with its parts (:func:`exact_metrics`; module docstring). ``to_json`` gives the
+    plain numbers a checkpoint and a preset's provenance store, in this order; ``from_json`` reads
+    them back (a field missing or unknown raises ``ValueError`` naming it)."""
+
+    exact_loss: float
+    stride_rel_error: float  # mean over the runs of |stride ratio - 1|
+    stride_ratio: tuple[float, ...]  # per run with strides
+    stride_term: float
+    duty_term: float
+    curvature_energy_mean: float
+    curvature_energy_se: float  # standard error of that mean (tuning._tune's guard)
+    curvature_term: float
+    clearance_mean_m: float
+    clearance_term: float
+    jerk_median: float
+    collisions: int
+    finite: bool
+    plans: int
+    leg_height_m: float
+    runs: tuple[ExactRun, ...]
+
+    def to_json(self) -> dict:
+        out = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        out["stride_ratio"] = list(self.stride_ratio)
+        out["runs"] = [dataclasses.asdict(r) for r in self.runs]
+        return out
+
+    @classmethod
+    def from_json(cls, data) -> "ExactMetrics":
+        if not isinstance(data, dict):
+            raise ValueError("exact metrics: expected an object")
+        names = [f.name for f in dataclasses.fields(cls)]
+        run_names = [f.name for f in dataclasses.fields(ExactRun)]
+        for key in names:
+            if key not in data:
+                raise ValueError(f"exact metrics: {key}: missing field")
+        for key in data:
+            if key not in names:
+                raise ValueError(f"exact metrics: {key}: unknown field")
+        runs = []
+        for i, run in enumerate(data["runs"]):
+            if not isinstance(run, dict) or sorted(run) != sorted(run_names):
+                raise ValueError(f"exact metrics: runs[{i}]: expected the fields {', '.join(run_names)}")
+            runs.append(ExactRun(**run))
+        return cls(**{**data, "stride_ratio": tuple(data["stride_ratio"]), "runs": tuple(runs)})
+
+
+def exact_metrics(setup: ExactSetup, weights=None, timing=None, targets=None, map_tasks=None) -> ExactMetrics:
+    """Run the sweep and return the exact loss with its parts (:class:`ExactMetrics`).
 
     Each run is a task (:func:`exact_tasks`, :func:`run_exact_task`); ``map_tasks(function, tasks)
     -> list`` (results in task order, e.g. from ``footfall._distribute.task_runner``) runs them, on
@@ -269,13 +336,12 @@ def exact_metrics(setup: ExactSetup, weights=None, timing=None, targets=None, ma
         # This run's share of the loss's per-run terms (tuning._tune compares candidates run by run).
         run_loss = 0.5 * ((0.0 if math.isnan(ratio) else ((ratio - 1.0) / stride_t["relative_tolerance"]) ** 2)
                           + out * out)
-        per_run.append({"scenario": r["scenario"], "seed": r["seed"], "froude": r["froude"], "run_loss": run_loss,
-                        "desired_speed": r["desired_speed"],
-                        "realised_speed": float(np.mean(r["speed"])) if r["speed"].size else 0.0,
-                        "strides": int(r["stride"].size), "stride_ratio": None if math.isnan(ratio) else ratio,
-                        "commanded_ratio": None if math.isnan(commanded) else commanded,
-                        "duty_factor": duty, "commanded_duty": None if math.isnan(duty_cmd) else duty_cmd,
-                        "collisions": r["collisions"]})
+        per_run.append(ExactRun(
+            scenario=r["scenario"], seed=r["seed"], froude=r["froude"], run_loss=run_loss,
+            desired_speed=r["desired_speed"], realised_speed=float(np.mean(r["speed"])) if r["speed"].size else 0.0,
+            strides=int(r["stride"].size), stride_ratio=None if math.isnan(ratio) else ratio,
+            commanded_ratio=None if math.isnan(commanded) else commanded, duty_factor=duty,
+            commanded_duty=None if math.isnan(duty_cmd) else duty_cmd, collisions=r["collisions"]))
     if not ratios:
         raise RuntimeError(f"exact loss: no strides measured for {setup.creature} (too few frames?)")
     ratios = np.asarray(ratios)
@@ -296,11 +362,9 @@ def exact_metrics(setup: ExactSetup, weights=None, timing=None, targets=None, ma
     jerk_term = max(0.0, math.log(max(jerk, 1e-300) / jerk_max)) ** 2
     loss = (0.5 * (stride_term + duty_term + curvature_term + clearance_term) + COLLISION_PENALTY * collisions
             + setup.jerk_weight * jerk_term)
-    return {
-        "exact_loss": float(loss), "stride_rel_error": float(np.mean(np.abs(ratios - 1.0))),
-        "stride_ratio": [float(x) for x in ratios], "stride_term": stride_term, "duty_term": duty_term,
-        "curvature_energy_mean": curvature, "curvature_energy_se": curvature_se, "curvature_term": curvature_term,
-        "clearance_mean_m": clearance, "clearance_term": clearance_term, "jerk_median": jerk, "collisions": collisions,
-        "finite": all(r["finite"] for r in runs), "plans": int(raw_all.shape[0]), "leg_height_m": h,
-        "runs": per_run,
-    }
+    return ExactMetrics(
+        exact_loss=float(loss), stride_rel_error=float(np.mean(np.abs(ratios - 1.0))),
+        stride_ratio=tuple(float(x) for x in ratios), stride_term=stride_term, duty_term=duty_term,
+        curvature_energy_mean=curvature, curvature_energy_se=curvature_se, curvature_term=curvature_term,
+        clearance_mean_m=clearance, clearance_term=clearance_term, jerk_median=jerk, collisions=collisions,
+        finite=all(r["finite"] for r in runs), plans=int(raw_all.shape[0]), leg_height_m=h, runs=tuple(per_run))

@@ -73,7 +73,7 @@ import numpy as np
 
 from footfall._atomic import make_folder, write_text_atomic
 from footfall._errors import InputError
-from footfall.tuning._exact import JERK_GUARD, ExactSetup, exact_metrics, speeds_for
+from footfall.tuning._exact import JERK_GUARD, ExactMetrics, ExactSetup, exact_metrics, speeds_for
 
 CHECKPOINT_FORMAT = "footfall-tune-checkpoint"
 CHECKPOINT_VERSION = 3
@@ -341,16 +341,16 @@ def _bucket(x: int, step: int) -> int:
     return max(step, int(math.ceil(x / step)) * step)
 
 
-def _by_froude(exact: dict, leg_height: float, value) -> list[tuple[float, float]]:
+def _by_froude(exact: ExactMetrics, leg_height: float, value) -> list[tuple[float, float]]:
     """(mean realised Fr, mean value(run)) per Froude number of the sweep, sorted; runs where
     ``value`` is None or the pelvis did not move are left out."""
     from footfall.planner import GRAVITY
 
     groups: dict[float, list[tuple[float, float]]] = {}
-    for run in exact["runs"]:
+    for run in exact.runs:
         y = value(run)
-        if y is not None and run["realised_speed"] > 0.0:
-            groups.setdefault(run["froude"], []).append((run["realised_speed"] ** 2 / (GRAVITY * leg_height), y))
+        if y is not None and run.realised_speed > 0.0:
+            groups.setdefault(run.froude, []).append((run.realised_speed ** 2 / (GRAVITY * leg_height), y))
     return sorted((float(np.mean([p[0] for p in v])), float(np.mean([p[1] for p in v]))) for v in groups.values())
 
 
@@ -362,19 +362,18 @@ def _interpolate(points, froude: np.ndarray, default: float, bounds) -> np.ndarr
     return np.clip(np.interp(np.log(np.maximum(froude, 1e-12)), x, y), *bounds)
 
 
-def stride_correction(exact: dict, speeds_froude: np.ndarray, leg_height: float) -> np.ndarray:
+def stride_correction(exact: ExactMetrics, speeds_froude: np.ndarray, leg_height: float) -> np.ndarray:
     """c(Fr) at the situations' Froude numbers from the exact runs' realised / commanded strides
     (module docstring), clipped to :data:`CORRECTION_RANGE`; 1 where nothing was measured."""
-    points = _by_froude(exact, leg_height, lambda run: run["commanded_ratio"])
+    points = _by_froude(exact, leg_height, lambda run: run.commanded_ratio)
     return _interpolate(points, speeds_froude, 1.0, CORRECTION_RANGE)
 
 
-def duty_correction(exact: dict, speeds_froude: np.ndarray, leg_height: float) -> np.ndarray:
+def duty_correction(exact: ExactMetrics, speeds_froude: np.ndarray, leg_height: float) -> np.ndarray:
     """d(Fr): realised stance fraction - commanded duty factor of the exact runs, per Froude number
     of the sweep, interpolated in log Fr, clipped to :data:`DUTY_CORRECTION_RANGE`; 0 unmeasured."""
     def gap(run):
-        cmd = run.get("commanded_duty")
-        return None if cmd is None else run["duty_factor"] - cmd
+        return None if run.commanded_duty is None else run.duty_factor - run.commanded_duty
 
     return _interpolate(_by_froude(exact, leg_height, gap), speeds_froude, 0.0, DUTY_CORRECTION_RANGE)
 
@@ -402,7 +401,7 @@ def _harvest(config: TuneConfig, params: dict, seed: int, map_tasks=None):
                               timing=timing, max_situations=config.max_situations, map_tasks=map_tasks)
 
 
-def _fit_round(config: TuneConfig, params: dict, exact_current: dict, round_index: int, targets, map_tasks=None):
+def _fit_round(config: TuneConfig, params: dict, exact_current: ExactMetrics, round_index: int, targets, map_tasks=None):
     """Harvest under ``params``, fit; returns (new params, fit record)."""
     from footfall.planner import GRAVITY
     from footfall.tuning._fit import fit, initial_params, loss, make_problem
@@ -449,79 +448,136 @@ def spearman_proxy_exact(config: TuneConfig, params: dict, map_tasks=None) -> tu
 # --------------------------------------------------------------------------- checkpoint
 
 
-def _save_checkpoint(path: Path, state: dict) -> None:
-    write_text_atomic(path, json.dumps(state, indent=1, allow_nan=False) + "\n")
+@dataclass(frozen=True)
+class BestSoFar:
+    """The best parameters the outer loop accepted, their exact metrics, and the round (-1: the start)."""
+
+    params: dict
+    exact: ExactMetrics
+    round: int
 
 
-def _load_checkpoint(path: Path, config: TuneConfig) -> dict:
+@dataclass(frozen=True)
+class TuneCheckpoint:
+    """The outer loop's state after a round, as the checkpoint file holds it (:func:`tune` resumes
+    from it). Each round makes a new one (``dataclasses.replace``); ``to_json`` / ``from_json`` give
+    the file's fields in this order (float64 written with ``repr``: an exact round trip)."""
+
+    config: dict  # TuneConfig.to_json(): a resume with other settings is refused
+    round: int  # rounds done
+    stopped: bool  # the line search found no better step: the loop ends
+    current: dict  # the parameters the next round starts from
+    current_exact: ExactMetrics
+    best: BestSoFar
+    start_exact: ExactMetrics
+    default_exact: ExactMetrics | None  # the guards' reference; None: not measured (yet)
+    history: tuple[dict, ...]  # one record per round (fit, line search, decision)
+
+    def to_json(self) -> dict:
+        return {"format": CHECKPOINT_FORMAT, "version": CHECKPOINT_VERSION, "config": self.config,
+                "round": self.round, "stopped": self.stopped, "current": self.current,
+                "current_exact": self.current_exact.to_json(),
+                "best": {"params": self.best.params, "exact": self.best.exact.to_json(), "round": self.best.round},
+                "start_exact": self.start_exact.to_json(),
+                "default_exact": None if self.default_exact is None else self.default_exact.to_json(),
+                "history": list(self.history)}
+
+    @classmethod
+    def from_json(cls, data: dict, path: Path) -> "TuneCheckpoint":
+        """The checkpoint of a file's JSON; anything missing or malformed raises :class:`InputError`
+        naming the file and the field."""
+        for key in ("config", "round", "stopped", "current", "current_exact", "best", "start_exact", "default_exact",
+                    "history"):
+            if key not in data:
+                raise InputError(path, key, "corrupt checkpoint: missing field")
+        exact = {}
+        for key, value in (("current_exact", data["current_exact"]), ("best.exact", (data["best"] or {}).get("exact")),
+                           ("start_exact", data["start_exact"]), ("default_exact", data["default_exact"])):
+            if value is None and key == "default_exact":
+                exact[key] = None
+                continue
+            try:
+                exact[key] = ExactMetrics.from_json(value)
+            except (TypeError, ValueError) as e:
+                raise InputError(path, key, f"corrupt checkpoint: {e}") from None
+        try:
+            best = BestSoFar(params=data["best"]["params"], exact=exact["best.exact"], round=int(data["best"]["round"]))
+            for p in (data["current"], best.params):
+                _objects(p)
+        except (KeyError, TypeError, ValueError) as e:
+            raise InputError(path, "params", f"corrupt checkpoint: {e}") from None
+        return cls(config=data["config"], round=int(data["round"]), stopped=bool(data["stopped"]),
+                   current=data["current"], current_exact=exact["current_exact"], best=best,
+                   start_exact=exact["start_exact"], default_exact=exact["default_exact"],
+                   history=tuple(data["history"]))
+
+
+def _save_checkpoint(path: Path, state: TuneCheckpoint) -> None:
+    write_text_atomic(path, json.dumps(state.to_json(), indent=1, allow_nan=False) + "\n")
+
+
+def _load_checkpoint(path: Path, config: TuneConfig) -> TuneCheckpoint:
     if not path.exists():
         raise InputError(path, "checkpoint", "no checkpoint to resume from (run without --resume first)")
     try:
-        state = json.loads(path.read_text())
+        data = json.loads(path.read_text())
     except (OSError, UnicodeDecodeError) as e:
         raise InputError(path, "checkpoint", f"cannot read: {e}") from None
     except json.JSONDecodeError as e:
         raise InputError(path, "checkpoint", f"corrupt (not JSON: {e.msg} at line {e.lineno})") from None
-    if not isinstance(state, dict) or state.get("format") != CHECKPOINT_FORMAT:
+    if not isinstance(data, dict) or data.get("format") != CHECKPOINT_FORMAT:
         raise InputError(path, "format", f"corrupt: expected a {CHECKPOINT_FORMAT} file")
-    if state.get("version") != CHECKPOINT_VERSION:
-        raise InputError(path, "version", f"expected {CHECKPOINT_VERSION}, got {state.get('version')!r}")
-    for key in ("config", "round", "stopped", "current", "best", "start_exact", "default_exact", "history"):
-        if key not in state:
-            raise InputError(path, key, "corrupt checkpoint: missing field")
-    if state["config"] != config.to_json():
-        diff = sorted(k for k in config.to_json() if state["config"].get(k) != config.to_json()[k])
+    if data.get("version") != CHECKPOINT_VERSION:
+        raise InputError(path, "version", f"expected {CHECKPOINT_VERSION}, got {data.get('version')!r}")
+    if "config" in data and data["config"] != config.to_json():
+        theirs = data["config"] if isinstance(data["config"], dict) else {}
+        diff = sorted(k for k in config.to_json() if theirs.get(k) != config.to_json()[k])
         raise InputError(path, "config", f"the checkpoint was made with other settings ({', '.join(diff)})")
-    try:
-        for p in (state["current"], state["best"]["params"]):
-            _objects(p)
-    except (KeyError, TypeError, ValueError) as e:
-        raise InputError(path, "params", f"corrupt checkpoint: {e}") from None
-    return state
+    return TuneCheckpoint.from_json(data, path)
 
 
 # --------------------------------------------------------------------------- the loop
 
 
-def curvature_limit(default: dict, candidate: dict) -> float:
+def curvature_limit(default: ExactMetrics, candidate: ExactMetrics) -> float:
     """The highest mean curvature energy a candidate may have: the default weights' plus
     :data:`CURVATURE_NOISE_SE` standard errors of the difference (and :data:`CURVATURE_SLACK`)."""
-    se = math.hypot(default.get("curvature_energy_se", 0.0), candidate.get("curvature_energy_se", 0.0))
-    return default["curvature_energy_mean"] + CURVATURE_NOISE_SE * se + CURVATURE_SLACK
+    se = math.hypot(default.curvature_energy_se, candidate.curvature_energy_se)
+    return default.curvature_energy_mean + CURVATURE_NOISE_SE * se + CURVATURE_SLACK
 
 
-def paired_gain(best: dict, candidate: dict) -> tuple[float, float]:
+def paired_gain(best: ExactMetrics, candidate: ExactMetrics) -> tuple[float, float]:
     """(mean, standard error) over the runs of best's ``run_loss`` - the candidate's: the same runs
     (scenario, seed, speed) in the same order, with other parameters."""
-    a = np.array([r["run_loss"] for r in best["runs"]], dtype=np.float64)
-    b = np.array([r["run_loss"] for r in candidate["runs"]], dtype=np.float64)
+    a = np.array([r.run_loss for r in best.runs], dtype=np.float64)
+    b = np.array([r.run_loss for r in candidate.runs], dtype=np.float64)
     if a.shape != b.shape or a.size < 2:
         raise ValueError("paired_gain: expected the same runs (at least 2) in both")
     d = a - b
     return float(d.mean()), float(d.std(ddof=1) / math.sqrt(d.size))
 
 
-def _accept(candidate: dict, best: dict, default: dict, gain_noise_se: float = GAIN_NOISE_SE,
-            guards: bool = True, start: dict | None = None) -> tuple[bool, str]:
+def _accept(candidate: ExactMetrics, best: ExactMetrics, default: ExactMetrics, gain_noise_se: float = GAIN_NOISE_SE,
+            guards: bool = True, start: ExactMetrics | None = None) -> tuple[bool, str]:
     """(accepted, why). ``default``: the runtime defaults' metrics; ``start``: a mis-tuned start's
     (None: the start is the defaults). Each guard allows the higher of the two references: a tune
     may not make collisions, curvature or jerk worse than both where it began and the defaults."""
-    if not candidate["finite"]:
+    if not candidate.finite:
         return False, "non-finite run"
     if not guards:
-        if candidate["exact_loss"] < best["exact_loss"]:
+        if candidate.exact_loss < best.exact_loss:
             return True, "improved"
         return False, "exact loss did not improve"
     references = (default,) if start is None else (default, start)
-    if candidate["collisions"] > max(r["collisions"] for r in references):
+    if candidate.collisions > max(r.collisions for r in references):
         return False, "more collisions than the default weights (and the start)"
-    if candidate["curvature_energy_mean"] > max(curvature_limit(r, candidate) for r in references):
+    if candidate.curvature_energy_mean > max(curvature_limit(r, candidate) for r in references):
         return False, "curvature energy above the default weights' (and the start's)"
-    if candidate["jerk_median"] > (1.0 + JERK_GUARD) * max(r["jerk_median"] for r in references):
+    if candidate.jerk_median > (1.0 + JERK_GUARD) * max(r.jerk_median for r in references):
         return False, "median jerk above the default weights' and the start's (guard)"
-    if not candidate["exact_loss"] < best["exact_loss"]:
+    if not candidate.exact_loss < best.exact_loss:
         return False, "exact loss did not improve"
-    if candidate["stride_rel_error"] > best["stride_rel_error"]:
+    if candidate.stride_rel_error > best.stride_rel_error:
         return False, "stride error rose (the exact loss fell through another term)"
     if gain_noise_se > 0.0:
         gain, se = paired_gain(best, candidate)
@@ -530,17 +586,13 @@ def _accept(candidate: dict, best: dict, default: dict, gain_noise_se: float = G
     return True, "improved"
 
 
-def _gain_in_se(default: dict, tuned: dict) -> float | None:
+def _gain_in_se(default: ExactMetrics, tuned: ExactMetrics) -> float | None:
     """The held-out paired gain of ``tuned`` over ``default`` in standard errors (None: no spread)."""
     try:
         gain, se = paired_gain(default, tuned)
     except ValueError:
         return None
     return gain / se if se > 0.0 else None
-
-
-def _strip(metrics: dict) -> dict:
-    return {k: v for k, v in metrics.items() if k != "runs"} | {"runs": metrics["runs"]}
 
 
 def tune(config: TuneConfig, out: str | Path, resume: bool = False, progress=None, stop_after: int | None = None,
@@ -583,11 +635,11 @@ def _tune(config: TuneConfig, out, resume, progress, stop_after, write, evaluate
     total = config.rounds + 2
     if resume:
         state = _load_checkpoint(ckpt, config)
-        say(f"resumed at round {state['round']}", state["round"] + 1, total)
+        say(f"resumed at round {state.round}", state.round + 1, total)
     else:
         say("exact loss of the start", 0, total)
         start_params = _start_params(config)
-        start_exact = _strip(exact_metrics(setup, *_objects(start_params), targets=targets, map_tasks=map_tasks))
+        start_exact = exact_metrics(setup, *_objects(start_params), targets=targets, map_tasks=map_tasks)
         # The guards' references are the runtime's defaults and the start (:func:`_accept`): from a
         # start with strides 30 % long the median jerk is lower than the defaults' (the geometric
         # jerk grows as strides shorten), and a guard against the start alone refused every step
@@ -596,51 +648,45 @@ def _tune(config: TuneConfig, out, resume, progress, stop_after, write, evaluate
         default_exact = None if config.start_timing else start_exact  # None: not measured (yet)
         if config.start_timing and config.guards:
             say("exact loss of the default weights (the guards' reference)", 0, total)
-            default_exact = _strip(exact_metrics(setup, *_objects(_default_params()), targets=targets,
-                                                 map_tasks=map_tasks))
-        state = {"format": CHECKPOINT_FORMAT, "version": CHECKPOINT_VERSION, "config": config.to_json(),
-                 "round": 0, "stopped": False, "current": start_params, "current_exact": start_exact,
-                 "best": {"params": start_params, "exact": start_exact, "round": -1},
-                 "start_exact": start_exact, "default_exact": default_exact, "history": []}
+            default_exact = exact_metrics(setup, *_objects(_default_params()), targets=targets, map_tasks=map_tasks)
+        state = TuneCheckpoint(config=config.to_json(), round=0, stopped=False, current=start_params,
+                               current_exact=start_exact, best=BestSoFar(start_params, start_exact, -1),
+                               start_exact=start_exact, default_exact=default_exact, history=())
         _save_checkpoint(ckpt, state)
-    while state["round"] < config.rounds and not state["stopped"]:
-        r = state["round"]
+    while state.round < config.rounds and not state.stopped:
+        r = state.round
         say(f"round {r + 1}/{config.rounds}: harvest + fit", r + 1, total)
-        fitted, record = _fit_round(config, state["current"], state["current_exact"], r, targets, map_tasks)
+        fitted, record = _fit_round(config, state.current, state.current_exact, r, targets, map_tasks)
         say(f"round {r + 1}/{config.rounds}: exact loss", r + 1, total)
         # A backtracking line search on the exact loss from the current to the fitted parameters
         # (in log space): the proxy is a local model, the exact planner has the last word.
         tried = []
         for alpha in LINE_SEARCH:
-            params = _towards(state["current"], fitted, alpha)
+            params = _towards(state.current, fitted, alpha)
             candidate = exact_metrics(setup, *_objects(params), targets=targets, map_tasks=map_tasks)
-            accepted, why = _accept(candidate, state["best"]["exact"], state["default_exact"], config.gain_noise_se,
-                                    config.guards, state["start_exact"] if config.start_timing else None)
-            tried.append({"alpha": alpha, "exact_loss": candidate["exact_loss"],
-                          "stride_rel_error": candidate["stride_rel_error"], "decision": why})
+            accepted, why = _accept(candidate, state.best.exact, state.default_exact, config.gain_noise_se,
+                                    config.guards, state.start_exact if config.start_timing else None)
+            tried.append({"alpha": alpha, "exact_loss": candidate.exact_loss,
+                          "stride_rel_error": candidate.stride_rel_error, "decision": why})
             if accepted:
                 break
-        record.update(round=r, alpha=alpha, exact_loss=candidate["exact_loss"],
-                      stride_rel_error=candidate["stride_rel_error"], collisions=candidate["collisions"],
-                      curvature_energy_mean=candidate["curvature_energy_mean"],
-                      jerk_median=candidate["jerk_median"], accepted=accepted, decision=why, line_search=tried)
-        state["history"].append(record)
+        record.update(round=r, alpha=alpha, exact_loss=candidate.exact_loss,
+                      stride_rel_error=candidate.stride_rel_error, collisions=candidate.collisions,
+                      curvature_energy_mean=candidate.curvature_energy_mean,
+                      jerk_median=candidate.jerk_median, accepted=accepted, decision=why, line_search=tried)
         if accepted:
-            state["best"] = {"params": params, "exact": _strip(candidate), "round": r}
-            state["current"] = params
-            state["current_exact"] = _strip(candidate)
-        else:
-            state["stopped"] = True
-        state["round"] = r + 1
+            state = dataclasses.replace(state, best=BestSoFar(params, candidate, r), current=params,
+                                        current_exact=candidate)
+        state = dataclasses.replace(state, round=r + 1, stopped=not accepted, history=(*state.history, record))
         _save_checkpoint(ckpt, state)
-        if stop_after is not None and state["round"] >= stop_after:  # a simulated kill (tests)
+        if stop_after is not None and state.round >= stop_after:  # a simulated kill (tests)
             return TuneResult(preset={}, summary={}, wall_s=time.perf_counter() - t0, finished=False)
     if not evaluate:
         return TuneResult(preset={}, summary={}, wall_s=time.perf_counter() - t0, finished=True)
     say("held-out evaluation", total - 1, total)
-    best = state["best"]
+    best = state.best
     holdout = config.holdout_setup()
-    start_exact, default_exact = state["start_exact"], state["default_exact"]
+    start_exact, default_exact = state.start_exact, state.default_exact
     held_start = exact_metrics(holdout, *_objects(_start_params(config)), targets=targets, map_tasks=map_tasks)
     held_default = held_start
     if config.start_timing:
@@ -648,51 +694,52 @@ def _tune(config: TuneConfig, out, resume, progress, stop_after, write, evaluate
         if default_exact is None:  # guards off: not measured during the search
             default_exact = exact_metrics(setup, *_objects(_default_params()), targets=targets, map_tasks=map_tasks)
         held_default = exact_metrics(holdout, *_objects(_default_params()), targets=targets, map_tasks=map_tasks)
-    held_tuned = exact_metrics(holdout, *_objects(best["params"]), targets=targets, map_tasks=map_tasks)
+    held_tuned = exact_metrics(holdout, *_objects(best.params), targets=targets, map_tasks=map_tasks)
     refused = None
-    if best["round"] >= 0 and not config.start_timing and held_tuned["stride_rel_error"] > held_default["stride_rel_error"]:
+    if best.round >= 0 and not config.start_timing and held_tuned.stride_rel_error > held_default.stride_rel_error:
         # A preset earns its place on runs it was not fitted to: one that beat the defaults on the training
         # runs but walks worse on the held-out terrain is not shipped; the defaults are (and say why).
-        refused = (f"round {best['round']} refused on the held-out runs: stride error {held_tuned['stride_rel_error']:.4g} "
-                   f"> the defaults' {held_default['stride_rel_error']:.4g}")
-        best = {"params": _start_params(config), "exact": default_exact, "round": -1}
+        refused = (f"round {best.round} refused on the held-out runs: stride error {held_tuned.stride_rel_error:.4g} "
+                   f"> the defaults' {held_default.stride_rel_error:.4g}")
+        best = BestSoFar(_start_params(config), default_exact, -1)
         held_tuned = held_default
-    rho, n_couples = spearman_proxy_exact(config, best["params"], map_tasks)
-    weights, timing = _objects(best["params"])
+    rho, n_couples = spearman_proxy_exact(config, best.params, map_tasks)
+    weights, timing = _objects(best.params)
     from footfall import __version__
 
-    def brief(m: dict) -> dict:
+    def brief(m: ExactMetrics) -> dict:
         keys = ("exact_loss", "stride_rel_error", "stride_ratio", "collisions", "curvature_energy_mean",
                 "curvature_energy_se", "clearance_mean_m", "jerk_median", "plans")
-        return {k: m[k] for k in keys}
+        data = m.to_json()
+        return {k: data[k] for k in keys}
 
     summary = {
         "creature": config.creature,
-        "exact_loss_default": default_exact["exact_loss"], "exact_loss_tuned": best["exact"]["exact_loss"],
-        "stride_rel_error_default": default_exact["stride_rel_error"],
-        "stride_rel_error_tuned": best["exact"]["stride_rel_error"],
-        "heldout_stride_rel_error_default": held_default["stride_rel_error"],
-        "heldout_stride_rel_error_tuned": held_tuned["stride_rel_error"],
-        "heldout_exact_loss_default": held_default["exact_loss"], "heldout_exact_loss_tuned": held_tuned["exact_loss"],
-        "collisions_tuned": best["exact"]["collisions"] + held_tuned["collisions"],
+        "exact_loss_default": default_exact.exact_loss, "exact_loss_tuned": best.exact.exact_loss,
+        "stride_rel_error_default": default_exact.stride_rel_error,
+        "stride_rel_error_tuned": best.exact.stride_rel_error,
+        "heldout_stride_rel_error_default": held_default.stride_rel_error,
+        "heldout_stride_rel_error_tuned": held_tuned.stride_rel_error,
+        "heldout_exact_loss_default": held_default.exact_loss, "heldout_exact_loss_tuned": held_tuned.exact_loss,
+        "collisions_tuned": best.exact.collisions + held_tuned.collisions,
         "spearman_proxy_exact": rho, "spearman_couples": n_couples,
-        "rounds_run": state["round"], "best_round": best["round"],
+        "rounds_run": state.round, "best_round": best.round,
         "heldout_refused": refused,
         # The keys the terrain and style tunes share (tuning._tune_events; issue 18, item 7).
         "scenarios": list(setup.scenarios),
         "targets": targets[config.creature].to_json(),
-        "heldout_loss_default": held_default["exact_loss"], "heldout_loss_tuned": held_tuned["exact_loss"],
+        "heldout_loss_default": held_default.exact_loss, "heldout_loss_tuned": held_tuned.exact_loss,
         "heldout_gain_se": _gain_in_se(held_default, held_tuned),
-        "weights_max_rel_change": float(np.max(np.abs(np.asarray(best["params"]["weights"])
+        "weights_max_rel_change": float(np.max(np.abs(np.asarray(best.params["weights"])
                                                       / np.asarray(_default_params()["weights"]) - 1.0))),
         "spearman_metric_change": None,
     }
     if config.start_timing:
         summary.update({
             "start_timing": dict((str(k), float(v)) for k, v in config.start_timing),
-            "exact_loss_start": start_exact["exact_loss"], "stride_rel_error_start": start_exact["stride_rel_error"],
-            "heldout_stride_rel_error_start": held_start["stride_rel_error"],
-            "heldout_exact_loss_start": held_start["exact_loss"]})
+            "exact_loss_start": start_exact.exact_loss, "stride_rel_error_start": start_exact.stride_rel_error,
+            "heldout_stride_rel_error_start": held_start.stride_rel_error,
+            "heldout_exact_loss_start": held_start.exact_loss})
     provenance = {
         "tool": "footfall tune", "footfall_version": __version__,
         "targets": {"file": "tuning/data/targets.toml", "sha256": _file_hash(TARGETS_FILE)[len("sha256:"):],
@@ -708,16 +755,16 @@ def _tune(config: TuneConfig, out, resume, progress, stop_after, write, evaluate
                 "tau": config.tau, "steps_per_round": config.fit_steps},
         "scenarios": {"harvest": [f"{n} at the sweep speeds" for n in config.harvest_scenarios], "exact": list(setup.scenarios),
                       "heldout": list(holdout.scenarios)},
-        "seeds": {"harvest": [config.seed + r for r in range(state["round"])], "exact": list(setup.seeds),
+        "seeds": {"harvest": [config.seed + r for r in range(state.round)], "exact": list(setup.seeds),
                   "heldout": list(holdout.seeds), "spearman": config.seed + 1000},
         "speed_sweep_froude": list(setup.froude),
         "stride_definition": "distance a foot travels between consecutive touch-downs (same foot, one cycle) vs "
                              f"lambda_target = {targets[config.creature].stride_law_text()} at the pelvis's realised speed; stride_rel_error = mean "
                              "over the runs of |mean stride / mean target - 1|",
-        "losses": {"default": brief(default_exact), "tuned": brief(best["exact"]),
+        "losses": {"default": brief(default_exact), "tuned": brief(best.exact),
                    "heldout_default": brief(held_default), "heldout_tuned": brief(held_tuned),
                    **({"start": brief(start_exact), "heldout_start": brief(held_start)} if config.start_timing else {}),
-                   "rounds": state["history"]},
+                   "rounds": list(state.history)},
         "summary": summary,
     }
     creature = load_creature(config.creature)  # a preset names the creature, not its file
