@@ -15,12 +15,6 @@ from __future__ import annotations
 
 import math
 
-from footfall.planner._crowd import init_crowd
-from footfall.planner._simulation import simulate
-from footfall.planner._timing import GRAVITY, hip_height
-from footfall.scenarios import load_creature, load_scenario
-from footfall.scenarios._gait_schedule import gait_schedule
-
 FROUDE = (0.05, 0.2, 0.5)
 SCENARIOS = ("flat", "hills", "stairs")
 
@@ -28,6 +22,13 @@ SCENARIOS = ("flat", "hills", "stairs")
 def run(creatures=("spider", "ant", "quadruped", "robot5"), scenarios=SCENARIOS, froude=FROUDE, frames: int = 300,
         seed: int = 0, progress=None) -> list[dict]:
     """Rows (dicts) of the table; ``creatures`` are names or creature files."""
+    # Imported here, not at the top: ``python -m`` configures numba's cache before the kernels load.
+    from footfall.planner._crowd import init_crowd
+    from footfall.planner._simulation import simulate
+    from footfall.planner._timing import GRAVITY, hip_height
+    from footfall.scenarios import load_creature, load_scenario
+    from footfall.scenarios._gait_schedule import gait_schedule
+
     rows = []
     for name in creatures:
         creature = load_creature(name)
@@ -73,5 +74,8 @@ def markdown(rows: list[dict]) -> str:
 if __name__ == "__main__":  # python -m footfall.benchmarks.locomotion_bench [creature ...]
     import sys
 
+    from footfall import configure_numba_cache
+
+    configure_numba_cache()
     print(markdown(run(creatures=tuple(sys.argv[1:]) or ("spider", "ant", "quadruped", "robot5"),
                        progress=lambda m: print(m, file=sys.stderr))))

@@ -994,6 +994,9 @@ def main(argv: list[str] | None = None) -> None:
     ``footfall: error: FILE: FIELD: REASON`` on stderr and exits with code 2 (the parser's own
     boxed messages are not used); ``footfall`` or ``footfall bench`` alone print their help.
     """
+    from footfall import configure_numba_cache
+
+    configure_numba_cache()  # before any command imports the planner's kernels
     command = typer.main.get_command(app)
     _show_flags_as_flags(command)
     try:

@@ -4,10 +4,9 @@ footprint scoring and the best footprint-trajectory couple search.
 numpy + numba only: this package never imports JAX, pyvista or pxr.
 """
 
-from footfall.planner._cache import configure_numba_cache as _configure_numba_cache
 from footfall.planner._threads import configure_worker_wait as _configure_worker_wait
 
-_configure_numba_cache()
+# numba's cache folder is the entry points' to set (footfall.configure_numba_cache), not the import's.
 _configure_worker_wait()
 
 from footfall.planner._batch import BatchResult, FootBatch, make_batch, plan_batch  # noqa: E402

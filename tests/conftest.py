@@ -11,6 +11,10 @@ import pytest
 if os.environ.get("PYTEST_XDIST_WORKER"):
     os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 
+from footfall import configure_numba_cache  # noqa: E402
+
+configure_numba_cache()  # before any test module imports the planner's kernels (the CLI's main does the same)
+
 
 @pytest.fixture
 def kill_a_busy_worker():

@@ -76,6 +76,9 @@ def golden() -> dict:
 
 
 if __name__ == "__main__":
+    from footfall import configure_numba_cache
+
+    configure_numba_cache()
     values = golden()
     if "--write" in sys.argv[1:]:
         GOLDEN.parent.mkdir(parents=True, exist_ok=True)
