@@ -21,6 +21,15 @@ class InputError(ValueError):
         Dotted path of the offending field, e.g. ``obstacles[2].size``.
     reason:
         Why it is refused, phrased for the user.
+
+    Examples
+    --------
+    >>> from footfall import InputError
+    >>> error = InputError("my_scenario.toml", "obstacles[2].size", "expected 3 positive numbers")
+    >>> str(error)
+    'my_scenario.toml: obstacles[2].size: expected 3 positive numbers'
+    >>> isinstance(error, ValueError), error.field
+    (True, 'obstacles[2].size')
     """
 
     def __init__(self, file: str | Path, field: str, reason: str) -> None:

@@ -32,6 +32,17 @@ def kernel_sources_digest(folder: Path) -> str:
     """16 hex digits of a hash of the kernel sources in ``folder`` (a planner package folder): their
     names and bytes, in name order.
 
+    Parameters
+    ----------
+    folder : pathlib.Path
+        A folder holding ``_kernels_*.py`` and the modules of their constants.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
     >>> import tempfile
     >>> with tempfile.TemporaryDirectory() as d:
     ...     _ = (Path(d) / "_kernels_a.py").write_text("x = 1")
@@ -58,6 +69,21 @@ def configure_numba_cache() -> Path:
     Call it before importing ``footfall.planner``: numba picks a kernel's cache folder when the kernel
     is defined, so kernels imported before keep the folder of that time (a ``RuntimeWarning`` says so
     when this call moves the folder after the planner was imported).
+
+    Returns
+    -------
+    pathlib.Path
+        The cache folder, ``ROOT/<16 hex digits>``.
+
+    Examples
+    --------
+    >>> import os
+    >>> from footfall import configure_numba_cache
+    >>> folder = configure_numba_cache()
+    >>> os.environ["NUMBA_CACHE_DIR"] == str(folder), len(folder.name)
+    (True, 16)
+    >>> configure_numba_cache() == folder  # again: the same folder, not one nested inside it
+    True
     """
     spec = importlib.util.find_spec("footfall.planner")  # its folder, without running its __init__
     folder = Path(spec.submodule_search_locations[0])

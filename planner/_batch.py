@@ -16,7 +16,48 @@ from footfall.planner._weights import N_TERMS, ScoringWeights
 
 @dataclass(frozen=True)
 class FootBatch:
-    """Struct-of-arrays planning requests (see :func:`make_batch`)."""
+    """Struct-of-arrays planning requests (see :func:`make_batch`).
+
+    F feet of C characters, whose local maps (N x N cells each) are stacked; foot i plans on
+    the maps of character ``foot_char[i]``. Every array is read-only in spirit: the planning
+    kernel reads them as they are.
+
+    Attributes
+    ----------
+    elevation, ground, forbidden : ndarray, shape (C, N, N)
+        The characters' stacked local maps (:class:`LocalMaps`).
+    origins : ndarray, shape (C, 2)
+        World (x, z) of each local map's origin corner.
+    foot_char : ndarray of int, shape (F,)
+        Index of each foot's maps.
+    foot_shape : ndarray, shape (F, 3)
+        Each foot's length, width (m) and yaw (rad).
+    sources : ndarray, shape (F, 3)
+        Where each foot is now, world (x, y, z).
+    preferred, hips : ndarray, shape (F, 2)
+        Each foot's preferred footprint and its leg's hip, world (x, z).
+    reach_xz, step_height, block_radius : ndarray, shape (F,)
+        Each leg's horizontal reach, its preferred step height and the room other feet leave
+        the foot (:attr:`FootQuery.feet_block_radius`), m.
+    legs, legs_start : ndarray
+        The other legs of every foot, rows (hip_x, hip_z, foot_x, foot_z), shape (sum M, 4);
+        foot i's are rows ``legs_start[i]:legs_start[i + 1]`` (shape (F + 1,)).
+    couples_after_first, slice_size, early : ndarray, shape (F,)
+        Each foot's search budget (:meth:`SearchBudget.kernel_args`): couples after the first
+        valid one (-1 = unlimited), slice size in m (-1 = no slices), the paper's early stop.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from footfall.planner import FootQuery, GridFrame, LocalMaps, make_batch
+    >>> flat = np.zeros((35, 35))
+    >>> maps = LocalMaps(GridFrame(0.0, 0.0, 0.07, 35, 35), flat, flat, np.zeros((35, 35), np.uint8))
+    >>> query = FootQuery(source=(1.2, 0.0, 1.2), preferred=(1.4, 1.2), hip=(1.1, 1.1), reach_xz=0.5,
+    ...                   step_height=0.05, foot_length=0.03, foot_width=0.02, foot_yaw=0.0)
+    >>> batch = make_batch([maps], [(0, query)])
+    >>> batch.n_feet, batch.elevation.shape, batch.sources
+    (1, (1, 35, 35), array([[1.2, 0. , 1.2]]))
+    """
 
     elevation: np.ndarray  # (C, N, N)
     ground: np.ndarray
@@ -43,6 +84,45 @@ class FootBatch:
 
 @dataclass(frozen=True)
 class BatchResult:
+    """What :func:`plan_batch` found for each foot of a :class:`FootBatch` (row i: foot i).
+
+    The same numbers as :class:`CoupleResult` gives for one foot, as arrays. A foot with no
+    valid couple holds: its ``target`` is its source and its ``trajectory`` repeats it.
+
+    Attributes
+    ----------
+    valid : ndarray of bool, shape (F,)
+        A couple was found.
+    target : ndarray, shape (F, 3)
+        The footprints, world (x, y, z).
+    slice_index : ndarray of int, shape (F,)
+        The elevation slice of each trajectory (0: no slices, as in :class:`CoupleResult`).
+    slice_level : ndarray, shape (F,)
+        Height above the terrain of that slice, m (``inf``: no slices).
+    scores : ndarray, shape (F, 3)
+        Couple, footprint and trajectory scores.
+    terms : ndarray, shape (F, 10)
+        Goodness per criterion, in :data:`SCORE_TERMS` order.
+    raw : ndarray, shape (F, 5)
+        Raw trajectory metrics, in :data:`RAW_METRICS` order.
+    counters : ndarray of int, shape (F, 6)
+        The search's work, in :data:`COUNTERS` order.
+    trajectory : ndarray, shape (F, K, 3)
+        Each swing's samples, source to target (K = ``PlannerConfig.trajectory_samples``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from footfall.planner import FootQuery, GridFrame, LocalMaps, make_batch, plan_batch
+    >>> flat = np.zeros((35, 35))
+    >>> maps = LocalMaps(GridFrame(0.0, 0.0, 0.07, 35, 35), flat, flat, np.zeros((35, 35), np.uint8))
+    >>> query = FootQuery(source=(1.2, 0.0, 1.2), preferred=(1.4, 1.2), hip=(1.1, 1.1), reach_xz=0.5,
+    ...                   step_height=0.05, foot_length=0.03, foot_width=0.02, foot_yaw=0.0)
+    >>> result = plan_batch(make_batch([maps], [(0, query)]))
+    >>> result.valid, result.scores.shape, result.terms.shape, result.trajectory.shape
+    (array([ True]), (1, 3), (1, 10), (1, 32, 3))
+    """
+
     valid: np.ndarray  # (F,) bool
     target: np.ndarray  # (F, 3)
     slice_index: np.ndarray
@@ -56,7 +136,43 @@ class BatchResult:
 
 def make_batch(maps: list[LocalMaps], requests: list[tuple[int, FootQuery]],
                budgets: SearchBudget | list[SearchBudget] = DEFAULT_BUDGET) -> FootBatch:
-    """Pack ``(map index, query)`` pairs into arrays (once, outside the hot path)."""
+    """Pack ``(map index, query)`` pairs into arrays (once, outside the hot path).
+
+    Parameters
+    ----------
+    maps : list of LocalMaps
+        The characters' local maps, at least one, all of the same shape.
+    requests : list of (int, FootQuery)
+        One pair per foot: the index into ``maps`` of the maps it plans on, and its query.
+    budgets : SearchBudget or list of SearchBudget, optional
+        One budget for every foot, or one per request; default :data:`DEFAULT_BUDGET`.
+
+    Returns
+    -------
+    FootBatch
+        The requests as arrays, in request order.
+
+    Raises
+    ------
+    ValueError
+        For no maps, maps of different shapes, a map index out of range or a number of budgets
+        other than the number of requests.
+
+    Examples
+    --------
+    Two feet planned on one character's maps, the second with the first valid couple only:
+
+    >>> import numpy as np
+    >>> from footfall.planner import DEFAULT_BUDGET, FIRST_VALID, FootQuery, GridFrame, LocalMaps, make_batch
+    >>> flat = np.zeros((35, 35))
+    >>> maps = LocalMaps(GridFrame(0.0, 0.0, 0.07, 35, 35), flat, flat, np.zeros((35, 35), np.uint8))
+    >>> def foot(x):
+    ...     return FootQuery(source=(x, 0.0, 1.2), preferred=(x + 0.2, 1.2), hip=(x, 1.1), reach_xz=0.5,
+    ...                      step_height=0.05, foot_length=0.03, foot_width=0.02, foot_yaw=0.0)
+    >>> batch = make_batch([maps], [(0, foot(1.0)), (0, foot(1.2))], [DEFAULT_BUDGET, FIRST_VALID])
+    >>> batch.n_feet, batch.foot_char, batch.couples_after_first
+    (2, array([0, 0]), array([6, 0]))
+    """
     if not maps:
         raise ValueError("maps: at least one local map is needed")
     shape = maps[0].elevation.shape
@@ -97,7 +213,44 @@ def make_batch(maps: list[LocalMaps], requests: list[tuple[int, FootQuery]],
 
 def plan_batch(batch: FootBatch, weights: ScoringWeights | None = None, config: PlannerConfig | None = None,
                mode: str = "search", parallel: bool = False) -> BatchResult:
-    """Plan every foot of ``batch`` in one kernel call (``parallel``: over the cores; same results)."""
+    """Plan every foot of ``batch`` in one kernel call (``parallel``: over the cores; same results).
+
+    Each foot is planned as :func:`plan_foot` plans it, with its own budget from the batch.
+
+    Parameters
+    ----------
+    batch : FootBatch
+        The requests (:func:`make_batch`).
+    weights : ScoringWeights, optional
+        The criteria's weights; default ``ScoringWeights()``.
+    config : PlannerConfig, optional
+        Static planner parameters; default ``PlannerConfig()``. Its cell size must be the maps'.
+    mode : {"search", "per_target", "brute_force"}, optional
+        As for :func:`plan_foot`.
+    parallel : bool, optional
+        Spread the feet over the cores (numba ``prange``); the results are the same.
+
+    Returns
+    -------
+    BatchResult
+        Row i is foot i's couple.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from footfall.planner import FootQuery, GridFrame, LocalMaps, make_batch, plan_batch, plan_foot
+    >>> flat = np.zeros((35, 35))
+    >>> maps = LocalMaps(GridFrame(0.0, 0.0, 0.07, 35, 35), flat, flat, np.zeros((35, 35), np.uint8))
+    >>> def foot(x):
+    ...     return FootQuery(source=(x, 0.0, 1.2), preferred=(x + 0.2, 1.2), hip=(x, 1.1), reach_xz=0.5,
+    ...                      step_height=0.05, foot_length=0.03, foot_width=0.02, foot_yaw=0.0)
+    >>> result = plan_batch(make_batch([maps], [(0, foot(1.0)), (0, foot(1.2))]))
+    >>> result.valid, result.target
+    (array([ True,  True]), array([[1.2, 0. , 1.2],
+           [1.4, 0. , 1.2]]))
+    >>> bool(np.array_equal(result.trajectory[1], plan_foot(maps, foot(1.2)).trajectory))  # as plan_foot plans
+    True
+    """
     weights = weights or ScoringWeights()
     config = config or PlannerConfig()
     n = batch.n_feet

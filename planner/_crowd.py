@@ -93,6 +93,67 @@ class ControllerConfig:
     just under the fastest walk its legs sustain, with the gait of that speed. A step begun
     while the body stands takes the swing time of the walk it resumes (``stage_plan``), and a
     foot in the air when its sector starts keeps its turn (``stage_gait``).
+
+    The defaults, and the measurements behind the switches that are off, are in the source
+    beside each field.
+
+    Attributes
+    ----------
+    turn_rate : float
+        rad/s, the fastest a heading changes.
+    acceleration : float
+        m/s^2, the fastest the speed changes.
+    arrive_radius : float
+        m, distance at which a waypoint counts as reached.
+    avoid_margin : float
+        m beyond the rest radius within which forbidden boxes push the heading.
+    replan_heading, replan_speed, replan_spacing : float
+        The turn (rad), relative speed change and relative change of the feet spacing after
+        which a swinging foot re-plans.
+    feedback_threshold, feedback_gain : float
+        Feet feedback: the mean offset (x rest radius) that moves the pelvis, and the rate (1/s)
+        at which it does.
+    step_height_factor : float
+        The swings' preferred lift, x standing height.
+    reach_margin : float
+        A stance foot beyond this fraction of its leg's reach steps.
+    threat_margin, threat_horizon : float
+        A moving box within ``threat_margin`` m of a stance foot, now or ``threat_horizon`` s
+        from now, makes it step.
+    bob_factor : float
+        Pelvis bobbing amplitude, x standing height.
+    pelvis_lag : float
+        s, time constant of the body following its support hull; 0: none (the paper's pose).
+    lookahead_frames, lookahead_every : int
+        Stance feet the IK cannot follow this many frames ahead step now; frames between two
+        look-ahead checks of a character.
+    ik_slip_margin : float
+        m, IK residual that counts as 'cannot follow'.
+    ik_iterations, ik_swing_iterations, ik_restarts : int
+        CCD sweeps per stance leg and frame (restarts included), per swinging leg and frame,
+        and restarts of a stalled stance leg.
+    hold_backoff, limit_recovery : float
+        Sustainable speed (above): the limit after a hold, x the speed held at, in (0, 1]; its
+        growth, x the desired speed per second, > 0.
+    others_in_maps : bool
+        Other characters' bodies and feet are forbidden in the local maps.
+    avoid_others_feet : bool
+        Other characters' feet near a planned footprint keep a foot's room.
+
+    Examples
+    --------
+    >>> from footfall.planner import ControllerConfig, init_crowd
+    >>> from footfall.scenarios import default_gait, load_creature, load_scenario
+    >>> slow_turns = ControllerConfig(turn_rate=0.75)          # half the default rate
+    >>> spider = load_creature("spider")
+    >>> model, state = init_crowd(load_scenario("flat"), spider, default_gait(spider), n_characters=1,
+    ...                           controller=slow_turns)
+    >>> model.controller.turn_rate, model.controller.acceleration
+    (0.75, 1.0)
+    >>> ControllerConfig(hold_backoff=0.0)
+    Traceback (most recent call last):
+    ...
+    ValueError: ControllerConfig.hold_backoff: expected a number in (0, 1], got 0.0
     """
 
     turn_rate: float = 1.5  # rad/s
@@ -149,6 +210,43 @@ def _rot_xz(heading, forward, lateral):
 
 @dataclass(frozen=True)
 class CrowdModel:
+    """The static part of a crowd: what does not change during a run (creature, gait, weights,
+    world raster, LOD settings). :func:`init_crowd` makes it; :func:`step` only reads it.
+
+    Its fields are described where they are defined, in the source of ``footfall.planner._crowd``
+    (``planner/_crowd.py``). The ones most often read:
+
+    Attributes
+    ----------
+    creature : scenarios.Creature
+        The characters' creature.
+    gait, schedule : scenarios.Gait, GaitSchedule
+        Its slowest gait, and its gaits by speed (``planner._gait_schedule``).
+    timing : GaitTiming
+        The gait timing (stride and duty laws).
+    weights, config, controller : ScoringWeights, PlannerConfig, ControllerConfig
+        The scoring weights, the planner parameters and the controller settings.
+    lod, lod_mode : LodConfig, str
+        The level-of-detail settings and mode (``"off"``, ``"on"`` or ``"zoomed"``).
+    raster : WorldRaster
+        The static world at the planner's cell size.
+    dt : float
+        s, the fixed time step (1/30 s).
+    speed_asked, speed_cap : float
+        m/s, the scenario's speed and the fastest the legs carry at the stride law.
+
+    Examples
+    --------
+    >>> from footfall.planner import init_crowd, step
+    >>> from footfall.scenarios import default_gait, load_creature, load_scenario
+    >>> scenario = load_scenario("flat"); spider = load_creature("spider")
+    >>> model, state = init_crowd(scenario, spider, default_gait(spider), n_characters=2, seed=0)
+    >>> model.n_legs, model.hips_body.shape, round(model.dt, 4)
+    (8, (8, 3), 0.0333)
+    >>> model.lod_mode, model.config.cell_size, model.speed_asked
+    ('off', 0.07, 0.3)
+    """
+
     creature: object
     gait: object
     timing: object
@@ -205,6 +303,44 @@ class CrowdModel:
 
 @dataclass
 class CrowdState:
+    """Every character's changing state, in arrays over C characters and L legs: pelvis pose and
+    speed, route, feet and their swings, gait manager, joint angles, counters. :func:`init_crowd`
+    makes it; :func:`step` changes it in place.
+
+    Its fields are described where they are defined, in the source of ``footfall.planner._crowd``
+    (``planner/_crowd.py``). The ones most often read:
+
+    Attributes
+    ----------
+    t, frame : float, int
+        Time (s) and the number of frames stepped.
+    pelvis : ndarray, shape (C, 3)
+        Pelvis positions, world (x, y, z).
+    heading, pitch, roll, speed : ndarray, shape (C,)
+        Body orientation (rad) and ground speed (m/s).
+    feet : ndarray, shape (C, L, 3)
+        Where each foot is, on the ground or in the air.
+    in_stance : ndarray of bool, shape (C, L)
+        The feet on the ground.
+    gaits : GaitManagerState
+        The gait manager of the crowd.
+    angles : ndarray, shape (C, L, S + 1)
+        Joint angles from the IK.
+    counters : dict
+        Running totals: ``steps``, ``plans``, ``holds``, ``replans``...
+
+    Examples
+    --------
+    >>> from footfall.planner import init_crowd, step
+    >>> from footfall.scenarios import default_gait, load_creature, load_scenario
+    >>> scenario = load_scenario("flat"); spider = load_creature("spider")
+    >>> model, state = init_crowd(scenario, spider, default_gait(spider), n_characters=2, seed=0)
+    >>> state.pelvis.shape, state.feet.shape, state.in_stance.shape
+    ((2, 3), (2, 8, 3), (2, 8))
+    >>> state.frame, bool(state.in_stance.all())    # every foot stands at the start
+    (0, True)
+    """
+
     t: float
     frame: int
     pelvis: np.ndarray  # (C, 3)
@@ -271,7 +407,30 @@ def hips_world(model: CrowdModel, state: CrowdState) -> np.ndarray:
 
 def sustained_speed(state: CrowdState) -> np.ndarray:
     """(C,) m/s: the speed each character heads for while it walks: the speed asked of it, held to the
-    limit its legs showed they sustain (lowered by holds, ControllerConfig.hold_backoff)."""
+    limit its legs showed they sustain (lowered by holds, ControllerConfig.hold_backoff).
+
+    Parameters
+    ----------
+    state : CrowdState
+        The crowd (its ``desired_speed`` and ``speed_limit``).
+
+    Returns
+    -------
+    ndarray, shape (C,)
+        m/s.
+
+    Examples
+    --------
+    >>> from footfall.planner import init_crowd, sustained_speed
+    >>> from footfall.scenarios import default_gait, load_creature, load_scenario
+    >>> scenario = load_scenario("flat"); spider = load_creature("spider")
+    >>> model, state = init_crowd(scenario, spider, default_gait(spider), n_characters=2, seed=0)
+    >>> sustained_speed(state)                      # never held: the scenario's 0.3 m/s
+    array([0.3, 0.3])
+    >>> state.speed_limit[0] = 0.25                 # as a hold would lower it
+    >>> sustained_speed(state)
+    array([0.25, 0.3 ])
+    """
     return np.minimum(state.desired_speed, state.speed_limit)
 
 
@@ -1690,7 +1849,28 @@ def set_feet_spacing(state: CrowdState, characters, scale) -> None:
 
 def planner_config_for(creature) -> PlannerConfig:
     """The paper's 70 x 70 maps of 7 cm cells, with finer cells (and a smaller candidate disc)
-    for creatures too small for 7 cm: about four cells from the body centre to a rest foot."""
+    for creatures too small for 7 cm: about four cells from the body centre to a rest foot.
+
+    Parameters
+    ----------
+    creature : scenarios.Creature
+        Its ``rest_radius`` (m) sets the cell size: a quarter of it rounded to 5 mm, between
+        1 and 7 cm; the candidate disc's radius is 0.75 rest radii, at most 25 cm.
+
+    Returns
+    -------
+    PlannerConfig
+
+    Examples
+    --------
+    >>> from footfall.planner import planner_config_for
+    >>> from footfall.scenarios import load_creature
+    >>> planner_config_for(load_creature("spider")).cell_size   # rest radius 0.36 m: the paper's 7 cm
+    0.07
+    >>> ant = planner_config_for(load_creature("ant"))          # rest radius 0.17 m: finer cells
+    >>> ant.map_cells, ant.cell_size, round(ant.search_radius_m, 3)
+    (70, 0.04, 0.125)
+    """
     rest = float(creature.rest_radius)
     cell = min(0.07, max(0.01, round(rest / 4.0 / 0.005) * 0.005))
     return PlannerConfig(cell_size=cell, search_radius_m=min(0.25, 0.75 * rest))
@@ -1705,6 +1885,72 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
 
     ``budget``: one search budget for every character instead of the paper's full search
     (only with ``lod_mode='off'``: the LOD modes set their own budgets).
+
+    The characters spawn around the scenario's crowd centre, clear of boxes, every foot at rest
+    and on the ground, and each follows the scenario's route shifted by its spawn offset.
+
+    Parameters
+    ----------
+    scenario : scenarios.Scenario
+        The world (terrain, obstacles), the crowd's spawn, route and speed, and the camera.
+    creature : scenarios.Creature
+        The characters' creature.
+    gait : scenarios.Gait or GaitSchedule
+        One gait, walked at every speed, or the creature's gaits by speed (a
+        ``planner._gait_schedule.GaitSchedule``, as ``scenarios._gait_schedule.gait_schedule``
+        makes them).
+    n_characters : int, optional
+        Characters in the crowd; default ``scenario.crowd.count``.
+    seed : int, optional
+        Seeds the gait phases and, with ``crowd.heading_mode = "random"``, the headings.
+    weights : ScoringWeights, optional
+        Default ``ScoringWeights()``.
+    timing : GaitTiming, optional
+        Default ``GaitTiming()``.
+    lod_mode : {"off", "on", "zoomed"}, optional
+        ``"off"``: every character runs the paper's full search and IK; ``"on"``: the camera frames
+        the whole crowd; ``"zoomed"``: it follows character 0 (:mod:`planner._lod`).
+    config : PlannerConfig, optional
+        Default :func:`planner_config_for` the creature.
+    controller : ControllerConfig, optional
+        Default ``ControllerConfig()``.
+    lod : LodConfig, optional
+        Default ``LodConfig()``.
+    raster : WorldRaster, optional
+        A raster to reuse, at the planner's cell size; rebuilt unless it holds the scenario's
+        boxes (compared by value).
+    budget : SearchBudget, optional
+        See above.
+
+    Returns
+    -------
+    model : CrowdModel
+        The static part.
+    state : CrowdState
+        Frame 0: every character standing at its spawn, at rest.
+
+    Raises
+    ------
+    footfall._errors.InputError
+        For an unknown ``lod_mode``, fewer than one character, a creature with no legs or too
+        large for its local map, or no room to spawn the crowd.
+    ValueError
+        For a ``budget`` with a LOD mode, or a raster of another cell size.
+
+    Examples
+    --------
+    >>> from footfall.planner import init_crowd, step
+    >>> from footfall.scenarios import default_gait, load_creature, load_scenario
+    >>> scenario = load_scenario("flat"); spider = load_creature("spider")
+    >>> model, state = init_crowd(scenario, spider, default_gait(spider), n_characters=2, seed=0)
+    >>> type(model).__name__, type(state).__name__, state.pelvis.shape
+    ('CrowdModel', 'CrowdState', (2, 3))
+    >>> state.desired_speed                         # the flat scenario's speed, under the legs' cap
+    array([0.3, 0.3])
+    >>> init_crowd(scenario, spider, default_gait(spider), lod_mode="fast")
+    Traceback (most recent call last):
+    ...
+    footfall._errors.InputError: argument: --lod: expected on, zoomed or off, got 'fast'
     """
     from footfall._errors import InputError
     from footfall.planner._gait import init_gaits
@@ -1908,7 +2154,31 @@ class FramePlans:
     ``kinds[i]`` (``planner.layout.KIND_*``), planned as ``result`` row i. ``batch``: the one
     planning call's requests when there was one on the paper's maps (what the tuning harvest
     re-scores; None when LOD split the frame); ``calls``: every planning call,
-    ``(FootBatch, PlannerConfig, request rows, characters)``, rows indexing the requests."""
+    ``(FootBatch, PlannerConfig, request rows, characters)``, rows indexing the requests.
+
+    Attributes
+    ----------
+    chars, legs, kinds : ndarray of int, shape (n,)
+        Character, leg and request kind of each planned foot.
+    result : BatchResult
+        The couples, row i for request i.
+    batch : FootBatch or None
+        The one planning call's requests, or None.
+    calls : tuple
+        Every planning call of the frame.
+
+    Examples
+    --------
+    >>> from footfall.planner import init_crowd, step
+    >>> from footfall.scenarios import default_gait, load_creature, load_scenario
+    >>> scenario = load_scenario("flat"); spider = load_creature("spider")
+    >>> model, state = init_crowd(scenario, spider, default_gait(spider), n_characters=2, seed=0)
+    >>> plans = step(model, state).plans            # the first frame plans some feet
+    >>> plans.chars.shape == plans.legs.shape == plans.kinds.shape == plans.result.valid.shape
+    True
+    >>> plans.batch.n_feet == plans.chars.size, len(plans.calls)   # LOD off: one call
+    (True, 1)
+    """
 
     chars: np.ndarray
     legs: np.ndarray
@@ -1921,14 +2191,68 @@ class FramePlans:
 @dataclass(frozen=True)
 class StepRecord:
     """What :func:`step` did: the seconds each stage took (``timings``, :data:`STAGES` order) and the
-    feet it planned (``plans``; None in a frame that planned none)."""
+    feet it planned (``plans``; None in a frame that planned none).
+
+    Attributes
+    ----------
+    timings : dict of str to float
+        Seconds per stage, keys :data:`STAGES` in order.
+    plans : FramePlans or None
+        The feet planned.
+
+    Examples
+    --------
+    >>> from footfall.planner import init_crowd, step
+    >>> from footfall.scenarios import default_gait, load_creature, load_scenario
+    >>> scenario = load_scenario("flat"); spider = load_creature("spider")
+    >>> model, state = init_crowd(scenario, spider, default_gait(spider), n_characters=2, seed=0)
+    >>> record = step(model, state)
+    >>> list(record.timings)
+    ['steer', 'gait', 'swing', 'requests', 'maps', 'plan', 'pelvis', 'ik']
+    >>> all(seconds >= 0 for seconds in record.timings.values())
+    True
+    """
 
     timings: dict
     plans: FramePlans | None
 
 
 def step(model: CrowdModel, state: CrowdState) -> StepRecord:
-    """Advance the crowd by one time step; returns what the step did (:class:`StepRecord`)."""
+    """Advance the crowd by one time step; returns what the step did (:class:`StepRecord`).
+
+    Runs the stages (:data:`STAGES`, described in the docstring of ``footfall.planner._crowd``)
+    in order, each batched over the characters; a foot with no valid couple holds and asks again
+    next frame (``step`` never raises for it).
+
+    Parameters
+    ----------
+    model : CrowdModel
+        The static part of the crowd.
+    state : CrowdState
+        Advanced in place by ``model.dt``.
+
+    Returns
+    -------
+    StepRecord
+        The stages' timings and the feet planned.
+
+    Examples
+    --------
+    >>> from footfall.planner import init_crowd, step
+    >>> from footfall.scenarios import default_gait, load_creature, load_scenario
+    >>> scenario = load_scenario("flat"); spider = load_creature("spider")
+    >>> model, state = init_crowd(scenario, spider, default_gait(spider), n_characters=2, seed=0)
+    >>> record = step(model, state)
+    >>> state.frame, round(state.t, 4)
+    (1, 0.0333)
+    >>> for _ in range(29):                         # one second in all
+    ...     record = step(model, state)
+    >>> state.speed                                 # up to speed at 1 m/s^2
+    array([0.3, 0.3])
+    >>> import numpy as np
+    >>> state.counters["steps"] > 0, bool(np.isfinite(state.pelvis).all())
+    (True, True)
+    """
     timings = {}
     clock = time.perf_counter
     state.t += model.dt

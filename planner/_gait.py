@@ -62,6 +62,18 @@ class GaitManagerState:
         (C,) duty factor the destination durations were scaled to; NaN = the gait as authored.
     leg_names:
         The legs' names when the gaits came as :class:`scenarios.Gait` values, else ``None``.
+
+    Examples
+    --------
+    >>> from footfall.planner import init_gaits
+    >>> from footfall.scenarios import default_gait, load_creature
+    >>> state = init_gaits(default_gait(load_creature("spider")), 2)
+    >>> state.n_characters, state.n_legs, state.needle.shape, state.disk_start.shape
+    (2, 8, (2,), (2, 8))
+    >>> state.leg_names[:4]
+    ('L1', 'L2', 'L3', 'L4')
+    >>> state.transitioning()                       # fresh from init_gaits: the disks are their destinations
+    array([False, False])
     """
 
     needle: np.ndarray
@@ -193,25 +205,59 @@ def init_gaits(gaits: Any, n_characters: int, rng_phase_offsets: Any = None, *,
                transition_rate: Any = DEFAULT_TRANSITION_RATE, duty_factor: Any = None) -> GaitManagerState:
     """The gait manager state of ``n_characters`` characters, not transitioning.
 
-    gaits:
-        A ``scenarios.Gait`` (every character), a list of ``n_characters``
-        gaits with the same legs, or a ``(start, duration)`` pair of (L,) or
-        (C, L) arrays.
-    rng_phase_offsets:
-        The needles' initial phases: ``None`` (all 0), an integer seed or a
-        ``numpy.random.Generator`` (uniform in [0, 1) per character, so a crowd
-        does not step in unison), or an array (C,) of phases in [0, 1).
-    transition_rate:
-        Cycles of phase per second (number or (C,)), >= 0.
-    duty_factor:
-        ``None``: the disks are the gaits as authored; else a duty factor in
-        (0, 1) (number or (C,)) the durations are scaled to right away
-        (:func:`planner._timing.scaled_swing_durations`).
-
     A foot swings when the needle *enters* its sector: a foot whose sector
     already holds a character's initial needle waits for the next cycle,
     except a sector starting exactly at the needle, which the first
     :func:`advance` enters.
+
+    Parameters
+    ----------
+    gaits : scenarios.Gait, list of scenarios.Gait, or (array_like, array_like)
+        A ``scenarios.Gait`` (every character), a list of ``n_characters``
+        gaits with the same legs, or a ``(start, duration)`` pair of (L,) or
+        (C, L) arrays.
+    n_characters : int
+        C, at least 1.
+    rng_phase_offsets : None, int, numpy.random.Generator or array_like, optional
+        The needles' initial phases: ``None`` (all 0), an integer seed or a
+        ``numpy.random.Generator`` (uniform in [0, 1) per character, so a crowd
+        does not step in unison), or an array (C,) of phases in [0, 1).
+    transition_rate : float or array_like, optional
+        Cycles of phase per second (number or (C,)), >= 0.
+    duty_factor : None, float or array_like, optional
+        ``None``: the disks are the gaits as authored; else a duty factor in
+        (0, 1) (number or (C,)) the durations are scaled to right away
+        (:func:`planner._timing.scaled_swing_durations`).
+
+    Returns
+    -------
+    GaitManagerState
+        New arrays, owned by the caller.
+
+    Raises
+    ------
+    ValueError
+        For a malformed gait (swing starts outside [0, 1), durations outside (0, 1), gaits
+        with different legs), a bad number of characters, phases or rates.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from footfall.planner import init_gaits
+    >>> from footfall.scenarios import default_gait, load_creature
+    >>> gait = default_gait(load_creature("spider"))   # eight legs, every swing 0.35 of a cycle
+    >>> state = init_gaits(gait, 3, rng_phase_offsets=0)
+    >>> bool(((state.needle >= 0) & (state.needle < 1)).all()), np.unique(state.needle).size  # seeded phases
+    (True, 3)
+    >>> init_gaits(gait, 1, duty_factor=0.75).disk_duration[0, :3]   # swings scaled to 1 - 0.75
+    array([0.25, 0.25, 0.25])
+
+    Two legs given as arrays, swings [0, 0.4) and [0.5, 0.9), and the needles' phases:
+
+    >>> state = init_gaits(([0.0, 0.5], [0.4, 0.4]), 2, [0.0, 0.7])
+    >>> state.active()                              # whose sector holds the needle
+    array([[ True, False],
+           [False,  True]])
     """
     if isinstance(n_characters, bool) or not isinstance(n_characters, (int, np.integer)) or n_characters < 1:
         raise ValueError(f"n_characters: expected an integer >= 1, got {n_characters!r}")
@@ -251,6 +297,44 @@ def set_destination(state: GaitManagerState, character_indices: Any, gait: Any, 
     destination durations are scaled to each character's current duty factor
     (the last :func:`set_speed`). The disks in use move toward it in later
     :func:`advance` calls, only while their foot is in stance.
+
+    Parameters
+    ----------
+    state : GaitManagerState
+        Changed in place.
+    character_indices : array_like of int or bool, or slice
+        The characters to move: indices, a (C,) boolean mask or a slice.
+    gait : scenarios.Gait, list of scenarios.Gait, or (array_like, array_like)
+        The destination gait, with the characters' legs (same number, same names).
+    transition_rate : float or array_like, optional
+        New cycles of phase per second for these characters (number or (k,)); default: keep
+        theirs.
+
+    Returns
+    -------
+    None
+
+    Raises
+    ------
+    ValueError
+        For bad indices, or a gait whose legs differ from the characters'.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from footfall.planner import advance, init_gaits, set_destination
+    >>> state = init_gaits(([0.0, 0.5], [0.4, 0.4]), 1)   # two legs in antiphase
+    >>> set_destination(state, [0], ([0.0, 0.25], [0.4, 0.4]))
+    >>> state.transitioning(), state.dest_start
+    (array([ True]), array([[0.  , 0.25]]))
+
+    At the default rate, 0.5 cycles of phase per second, the second disk's start moves from
+    0.5 to 0.25 in half a second while both feet stand:
+
+    >>> for _ in range(10):
+    ...     _ = advance(state, 1.0, 0.1, np.ones((1, 2), bool))
+    >>> state.disk_start, state.transitioning()
+    (array([[0.  , 0.25]]), array([False]))
     """
     rows = _indices(state, character_indices)
     if rows.size == 0:
@@ -281,9 +365,46 @@ def set_speed(state: GaitManagerState, timing: GaitTiming, speed: Any, height: A
     (C,)); records the duty factors and rescales every destination disk's duration to them
     (:mod:`planner._timing`). The disks in use follow at the transition rate while in stance.
 
-    ``duty_ceiling`` (number or (C,), > 0; default none): the largest duty factor the legs carry
+    ``duty_ceiling`` ((C,), > 0; default none): the largest duty factor the legs carry
     at this speed (:func:`planner._workspace.duty_ceiling`); the duty factor never falls below the
-    timing's ``duty_min`` for it."""
+    timing's ``duty_min`` for it.
+
+    Parameters
+    ----------
+    state : GaitManagerState
+        Changed in place: ``duty_factor``, ``dest_start`` and ``dest_duration``.
+    timing : GaitTiming
+        The timing model (stride law, duty law).
+    speed : float or array_like
+        m/s, >= 0, number or (C,).
+    height : float or array_like
+        h of the Froude number (the hip height, :func:`hip_height`), m, > 0, number or (C,).
+    duty_ceiling : array_like, shape (C,), optional
+        The largest duty factor each character's legs carry, > 0 (``inf``: no ceiling); default
+        none. A single number is refused.
+
+    Returns
+    -------
+    ndarray, shape (C,)
+        Stride frequencies, Hz: the rate for :func:`advance`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from footfall.planner import GaitTiming, hip_height, init_gaits, set_speed
+    >>> from footfall.scenarios import default_gait, load_creature
+    >>> spider = load_creature("spider")
+    >>> state = init_gaits(default_gait(spider), 2)
+    >>> frequency = set_speed(state, GaitTiming(), [0.1, 0.3], hip_height(spider))
+    >>> np.round(frequency, 3)                      # Hz: the faster character steps more often
+    array([1.515, 2.351])
+    >>> np.round(state.duty_factor, 3)              # ... and stands a smaller share of each cycle
+    array([0.7  , 0.659])
+    >>> np.round(state.dest_duration[:, 0], 3)      # the swings it heads for: 1 - duty factor here
+    array([0.3  , 0.341])
+    >>> state.transitioning()                       # the disks in use follow while their feet stand
+    array([ True,  True])
+    """
     n = state.n_characters
     v = _per_character(speed, n, "speed")
     h = _per_character(height, n, "height", positive=True)
@@ -301,18 +422,41 @@ def advance(state: GaitManagerState, frequency: Any, dt: float, in_stance: Any,
             out: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Step every character's needle by ``frequency * dt`` and its stance feet's disks toward the destination.
 
-    frequency:
-        Hz, number or (C,), >= 0 (e.g. from :func:`set_speed`).
-    dt:
-        Seconds, >= 0.
-    in_stance:
-        (C, L) bool, the feet on the ground at the start of the step.
-    out:
-        Optional ``(enter_swing, swing_fraction)`` arrays to write into.
-
     Returns ``(enter_swing, swing_fraction)``, both (C, L): the stance feet
     whose sector the needle entered in this step (they must start a swing),
     and each foot's progress through its sector (0 outside its sector).
+
+    Parameters
+    ----------
+    state : GaitManagerState
+        Changed in place: the needles, and the disks of stance feet during a transition.
+    frequency : float or array_like
+        Hz, number or (C,), >= 0 (e.g. from :func:`set_speed`).
+    dt : float
+        Seconds, >= 0.
+    in_stance : array_like of bool, shape (C, L)
+        The feet on the ground at the start of the step.
+    out : (ndarray, ndarray), optional
+        A bool and a float64 array of shape (C, L) to write the results into.
+
+    Returns
+    -------
+    enter_swing : ndarray of bool, shape (C, L)
+        The stance feet whose sector the needle entered in this step.
+    swing_fraction : ndarray, shape (C, L)
+        Each foot's progress through its sector, in [0, 1) (0 outside its sector).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from footfall.planner import advance, init_gaits
+    >>> state = init_gaits(([0.0, 0.5], [0.4, 0.4]), 1)   # swings [0, 0.4) and [0.5, 0.9)
+    >>> advance(state, 1.0, 0.1, np.ones((1, 2), bool))    # 1 Hz for 0.1 s: foot 0 lifts
+    (array([[ True, False]]), array([[0.25, 0.  ]]))
+    >>> advance(state, 1.0, 0.5, [[False, True]])          # the needle reaches 0.6: foot 1 lifts
+    (array([[False,  True]]), array([[0.  , 0.25]]))
+    >>> state.needle
+    array([0.6])
     """
     n, legs = state.disk_start.shape
     f = _per_character(frequency, n, "frequency")

@@ -38,7 +38,37 @@ def cell_centre(r: int, c: int, origin_x: float, origin_z: float, cell: float) -
 
 @dataclass(frozen=True)
 class GridFrame:
-    """Placement of a grid in the world (see the module docstring for the convention)."""
+    """Placement of a grid in the world (see the module docstring for the convention).
+
+    A ``cell_size`` that is not a positive finite number, or a shape with fewer than one row
+    or column, raises ValueError.
+
+    Attributes
+    ----------
+    origin_x, origin_z : float
+        World position (m) of the low-x, low-z corner of cell (0, 0).
+    cell_size : float
+        Side of a square cell (m), > 0.
+    n_rows, n_cols : int
+        Number of rows (along world z) and columns (along world x), >= 1.
+    shape : tuple of int
+        ``(n_rows, n_cols)``.
+
+    Examples
+    --------
+    >>> from footfall.planner import GridFrame
+    >>> grid = GridFrame(origin_x=0.0, origin_z=0.0, cell_size=0.5, n_rows=4, n_cols=6)
+    >>> grid.shape
+    (4, 6)
+    >>> rows, cols = grid.world_to_cell([1.2, -0.1], [0.7, 0.0])   # x, z -> row from z, column from x
+    >>> rows.tolist(), cols.tolist()
+    ([1, 0], [2, -1])
+    >>> x, z = grid.cell_to_world(1, 2)                            # centre of cell (1, 2)
+    >>> float(x), float(z)
+    (1.25, 0.75)
+    >>> grid.contains_cell([0, 3], [5, 6]).tolist()                # column 6 is past the last one
+    [True, False]
+    """
 
     origin_x: float
     origin_z: float

@@ -39,7 +39,47 @@ from footfall.planner.layout import FEATURES, N_FEATURES, N_RAW  # FEATURES: the
 
 @dataclass(frozen=True)
 class FootHarvest:
-    """All couples of one foot. n candidates (the search's order), S slices."""
+    """All couples of one foot. n candidates (the search's order), S slices.
+
+    Attributes
+    ----------
+    cand_cells : ndarray of int, shape (n, 2)
+        Local (row, col) of each candidate footprint, by descending footprint score.
+    cand_xyz : ndarray, shape (n, 3)
+        Target points: the continuous footprint in the cell, at the dilated elevation.
+    cand_features : ndarray, shape (n, 5)
+        Raw footprint features, columns :data:`FEATURES`.
+    cand_terms : ndarray, shape (n, 5)
+        Footprint goodnesses (the runtime's).
+    cand_scores : ndarray, shape (n,)
+        Footprint scores (the runtime's).
+    levels : ndarray, shape (S,)
+        Slice levels, m above terrain (``inf``: no slices).
+    d_ref : ndarray, shape (n,)
+        Each candidate's reference of the length goodness (source to footprint), m.
+    couple_valid : ndarray of bool, shape (n, S)
+        A path exists.
+    couple_raw : ndarray, shape (n, S, 5)
+        Raw trajectory metrics, in :data:`RAW_METRICS` order.
+    couple_terms : ndarray, shape (n, S, 10)
+        Goodnesses (the runtime's), in :data:`SCORE_TERMS` order.
+    couple_scores : ndarray, shape (n, S, 3)
+        Couple, footprint and trajectory scores (the runtime's).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from footfall.planner import FootQuery, GridFrame, LocalMaps, harvest_foot
+    >>> flat = np.zeros((35, 35))                   # 35 x 35 cells of 7 cm, flat ground at y = 0
+    >>> maps = LocalMaps(GridFrame(0.0, 0.0, 0.07, 35, 35), flat, flat, np.zeros((35, 35), np.uint8))
+    >>> query = FootQuery(source=(1.2, 0.0, 1.2), preferred=(1.4, 1.2), hip=(1.1, 1.1), reach_xz=0.5,
+    ...                   step_height=0.05, foot_length=0.03, foot_width=0.02, foot_yaw=0.0)
+    >>> harvest = harvest_foot(maps, query)
+    >>> harvest.cand_cells.shape, harvest.levels     # flat ground: one level, no slices
+    ((37, 2), array([inf]))
+    >>> harvest.couple_valid.shape, harvest.couple_scores.shape
+    ((37, 1), (37, 1, 3))
+    """
 
     cand_cells: np.ndarray  # (n, 2) local (row, col)
     cand_xyz: np.ndarray  # (n, 3) target points (continuous footprint in the cell, dilated elevation)
@@ -64,7 +104,50 @@ def _harvest_kernel_call(elevation, ground, forbidden, origin_x, origin_z, offse
 
 def harvest_foot(maps: LocalMaps, query: FootQuery, weights: ScoringWeights | None = None,
                  budget: SearchBudget = DEFAULT_BUDGET, config: PlannerConfig | None = None) -> FootHarvest:
-    """Every (candidate, slice) couple of one foot, scored in 3D (the budget gives only the slice size)."""
+    """Every (candidate, slice) couple of one foot, scored in 3D (the budget gives only the slice size).
+
+    The candidates are the search's (:func:`plan_foot`), in its order, and the couples are
+    scored as the search scores them, with no pruning: the best valid couple is the exhaustive
+    search's pick.
+
+    Parameters
+    ----------
+    maps : LocalMaps
+        The character's local maps (cell size ``config.cell_size``, containing the source).
+    query : FootQuery
+        The foot.
+    weights : ScoringWeights, optional
+        The criteria's weights; default ``ScoringWeights()``.
+    budget : SearchBudget, optional
+        Only its ``slice_size_m`` is used; default :data:`DEFAULT_BUDGET`.
+    config : PlannerConfig, optional
+        Static planner parameters; default ``PlannerConfig()``.
+
+    Returns
+    -------
+    FootHarvest
+        Every candidate and (candidate, slice) couple with its features, metrics and scores.
+
+    Raises
+    ------
+    ValueError
+        For maps whose cell size differs from ``config.cell_size`` or a source outside them.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from footfall.planner import EXHAUSTIVE, FootQuery, GridFrame, LocalMaps, harvest_foot, plan_foot
+    >>> flat = np.zeros((35, 35))                   # 35 x 35 cells of 7 cm, flat ground at y = 0
+    >>> maps = LocalMaps(GridFrame(0.0, 0.0, 0.07, 35, 35), flat, flat, np.zeros((35, 35), np.uint8))
+    >>> query = FootQuery(source=(1.2, 0.0, 1.2), preferred=(1.4, 1.2), hip=(1.1, 1.1), reach_xz=0.5,
+    ...                   step_height=0.05, foot_length=0.03, foot_width=0.02, foot_yaw=0.0)
+    >>> harvest = harvest_foot(maps, query)
+    >>> best = plan_foot(maps, query, budget=EXHAUSTIVE)
+    >>> bool(np.array_equal(harvest.cand_cells, best.candidate_cells))   # the search's candidates, in order
+    True
+    >>> float(harvest.couple_scores[..., 0].max()) == best.couple_score   # its best couple is the search's
+    True
+    """
     weights = weights or ScoringWeights()
     config = config or PlannerConfig()
     offsets = checked_foot_offsets(maps, query, config)
@@ -84,6 +167,51 @@ class Harvest:
     the candidate set, and the exhaustive search's pick (``chosen``: (k, s) or
     (-1, -1) when no couple exists) with its scores, goodnesses and raw metrics.
     ``crowd_choice`` is the couple the crowd's own (budgeted) search took.
+
+    Made by :func:`pack_harvest`; the per-candidate and per-couple arrays are those of each
+    situation's :class:`FootHarvest`, padded (``cand_mask`` and ``couple_mask`` say which
+    entries are real).
+
+    Attributes
+    ----------
+    creatures, scenarios : tuple of str
+        The names the ``creature`` and ``scenario`` indices refer to.
+    creature, scenario, seed, frame, character, leg, kind : ndarray of int, shape (F,)
+        Where each situation came from; ``kind`` is a request kind, ``planner.layout.KIND_*``.
+    leg_height, speed, relative_swing, cell_size : ndarray, shape (F,)
+        h of the Froude number (m), the character's speed when it planned (m/s), the leg's
+        authored swing duration over the mean of its legs', the maps' cell size (m).
+    forward, preferred : ndarray, shape (F, 2)
+        Unit heading and preferred footprint, (x, z).
+    source : ndarray, shape (F, 3)
+        Where the foot was, (x, y, z).
+    d_ref, cand_mask, cand_xyz, cand_centre_xz, cand_features, cand_terms, cand_scores : ndarray
+        Per candidate, shape (F, K, ...): as in :class:`FootHarvest`, plus the centres of the
+        candidate cells (``cand_centre_xz``; a footprint is its cell's point nearest the
+        preferred one); ``d_ref`` pads with 1.
+    couple_mask, couple_raw, couple_terms, couple_scores : ndarray
+        Per couple, shape (F, K, S, ...): as in :class:`FootHarvest`.
+    chosen, crowd_choice : ndarray of int, shape (F, 2)
+        (candidate, slice) of the exhaustive search's pick and of the crowd's; (-1, -1): none.
+    chosen_scores, chosen_terms, chosen_raw : ndarray
+        The exhaustive pick's scores (F, 3), goodnesses (F, 10) and raw metrics (F, 5).
+    weights, timing : ndarray
+        ``ScoringWeights.to_array()`` and ``GaitTiming.to_array()`` of the runs.
+
+    Examples
+    --------
+    >>> from footfall.planner import GaitTiming, ScoringWeights, harvest_run, pack_harvest
+    >>> from footfall.scenarios import default_gait, load_creature, load_scenario
+    >>> spider = load_creature("spider")
+    >>> run = harvest_run(load_scenario("flat"), spider, default_gait(spider), weights=ScoringWeights(),
+    ...                   timing=GaitTiming(), n_characters=1, seed=0, frames=5,
+    ...                   meta={"creature": 0, "scenario": 0, "seed": 0})
+    >>> harvest = pack_harvest(run["rows"], ["spider"], ["flat"], ScoringWeights().to_array(),
+    ...                        GaitTiming().to_array())
+    >>> harvest.n_situations == len(run["rows"]), harvest.cand_mask.shape[0] == harvest.n_situations
+    (True, True)
+    >>> bool(harvest.has_couple.all()), harvest.creatures, harvest.scenarios
+    (True, ('spider',), ('flat',))
     """
 
     creatures: tuple[str, ...]
@@ -178,7 +306,41 @@ def _harvest_batch(batch, weights, config, out, cs, ls, kinds, state, model, met
 def pack_harvest(rows: list[dict], creatures, scenarios, weights: np.ndarray, timing: np.ndarray) -> Harvest:
     """The rows of :func:`harvest_run` (merged by :func:`merge_harvest_chunks`) as one :class:`Harvest`:
     ``creatures`` and ``scenarios`` name the rows' indices; ``weights`` and ``timing`` are the packed
-    parameters the runs used."""
+    parameters the runs used.
+
+    Parameters
+    ----------
+    rows : list of dict
+        Situations from :func:`harvest_run`; each must carry ``creature``, ``scenario`` and
+        ``seed`` (indices and seed, from the run's ``meta``).
+    creatures, scenarios : sequence of str
+        The names of the rows' ``creature`` and ``scenario`` indices.
+    weights : ndarray
+        ``ScoringWeights.to_array()`` the runs used.
+    timing : ndarray
+        ``GaitTiming.to_array()`` the runs used.
+
+    Returns
+    -------
+    Harvest
+        F = ``len(rows)`` situations, padded to the most candidates (K) and slices (S) of any.
+
+    Examples
+    --------
+    >>> from footfall.planner import GaitTiming, ScoringWeights, harvest_run, pack_harvest
+    >>> from footfall.scenarios import default_gait, load_creature, load_scenario
+    >>> spider = load_creature("spider")
+    >>> run = harvest_run(load_scenario("flat"), spider, default_gait(spider), weights=ScoringWeights(),
+    ...                   timing=GaitTiming(), n_characters=1, seed=0, frames=5,
+    ...                   meta={"creature": 0, "scenario": 0, "seed": 0})
+    >>> harvest = pack_harvest(run["rows"], ["spider"], ["flat"], ScoringWeights().to_array(),
+    ...                        GaitTiming().to_array())
+    >>> f, k = harvest.cand_mask.shape
+    >>> f == len(run["rows"]), k == max(row["foot"].cand_scores.size for row in run["rows"])
+    (True, True)
+    >>> harvest.chosen.shape == (f, 2), harvest.couple_scores.shape[-1]   # (candidate, slice); 3 scores
+    (True, 3)
+    """
     f = len(rows)
     k = max([r["foot"].cand_scores.size for r in rows] + [1])
     s = max([r["foot"].levels.size for r in rows] + [1])
@@ -230,7 +392,35 @@ def pack_harvest(rows: list[dict], creatures, scenarios, weights: np.ndarray, ti
 def task_mapper(map_tasks=None):
     """``map_tasks`` checked, or (``None``) a lazy in-process map: ``run(function, tasks)`` gives the
     results in task order. One check for every caller that takes a ``map_tasks`` (the tuning's
-    harvests and exact runs)."""
+    harvests and exact runs).
+
+    Parameters
+    ----------
+    map_tasks : callable or None, optional
+        ``map_tasks(function, tasks)``, results in task order (for instance one that runs the
+        tasks on workers); ``None``: the built-in :func:`map`, lazy, in this process.
+
+    Returns
+    -------
+    callable
+        ``map_tasks`` itself, or :func:`map`.
+
+    Raises
+    ------
+    ValueError
+        When ``map_tasks`` is neither ``None`` nor callable.
+
+    Examples
+    --------
+    >>> from footfall.planner import task_mapper
+    >>> run = task_mapper()
+    >>> list(run(abs, [-1, 2, -3]))
+    [1, 2, 3]
+    >>> task_mapper(42)
+    Traceback (most recent call last):
+    ...
+    ValueError: map_tasks: expected None or a callable, got int
+    """
     if map_tasks is None:
         return map
     if not callable(map_tasks):
@@ -246,6 +436,52 @@ def harvest_run(scenario, creature, gait, *, weights: ScoringWeights, timing, n_
     frame that reaches ``max_situations``). ``meta`` (a dict) is copied into every row.
 
     Rows hold numpy arrays and :class:`FootHarvest` records: picklable, for a worker to send back.
+
+    Parameters
+    ----------
+    scenario : scenarios.Scenario
+        The world and the crowd's spawn.
+    creature : scenarios.Creature
+        The characters' creature.
+    gait : scenarios.Gait or GaitSchedule
+        Its gait, as for :func:`init_crowd`.
+    weights : ScoringWeights
+        The weights the crowd plans with and the situations are scored with.
+    timing : GaitTiming or None
+        The gait timing of the run (``None``: the default).
+    n_characters : int
+        Characters in the crowd.
+    seed : int
+        The crowd's seed (:func:`init_crowd`).
+    frames : int
+        Frames to run at most.
+    max_situations : int, optional
+        Stop at the end of the frame whose rows reach this many.
+    meta : dict, optional
+        Copied into every row (:func:`pack_harvest` reads ``creature``, ``scenario`` and ``seed``).
+
+    Returns
+    -------
+    dict
+        ``rows``: one dict per planning request, in order (its situation: frame, character,
+        leg, kind, kinematics, the :class:`FootHarvest` ``foot``, the exhaustive search's pick
+        ``chosen`` and the crowd's ``crowd_choice``...); ``frame_ends``: the row count after each
+        frame that planned.
+
+    Examples
+    --------
+    >>> from footfall.planner import GaitTiming, ScoringWeights, harvest_run
+    >>> from footfall.scenarios import default_gait, load_creature, load_scenario
+    >>> spider = load_creature("spider")
+    >>> run = harvest_run(load_scenario("flat"), spider, default_gait(spider), weights=ScoringWeights(),
+    ...                   timing=GaitTiming(), n_characters=1, seed=0, frames=5, meta={"seed": 0})
+    >>> run["frame_ends"][-1] == len(run["rows"])
+    True
+    >>> row = run["rows"][0]
+    >>> row["frame"], row["character"], row["seed"]     # planned in frame 1, by character 0
+    (1, 0, 0)
+    >>> row["chosen"]                                   # flat ground: the best footprint, the first slice
+    (0, 0)
     """
     from footfall.planner._crowd import init_crowd, planner_config_for, step
     from footfall.planner._maps import WorldRaster
@@ -280,7 +516,34 @@ def harvest_run(scenario, creature, gait, *, weights: ScoringWeights, timing, n_
 def merge_harvest_chunks(chunks, max_situations: int | None) -> list[dict]:
     """Concatenate the chunks' rows in task order, cut as the sequential loop cut: at the end of the
     first frame at which the running total reaches ``max_situations`` (whole frames; later chunks
-    add nothing, and are not even pulled from a lazy ``chunks``)."""
+    add nothing, and are not even pulled from a lazy ``chunks``).
+
+    Parameters
+    ----------
+    chunks : iterable of dict
+        :func:`harvest_run` results (``rows`` and ``frame_ends``), in task order; may be lazy.
+    max_situations : int or None
+        The cap; ``None``: every row.
+
+    Returns
+    -------
+    list
+        The rows, in order.
+
+    Examples
+    --------
+    Rows are letters here (any objects are merged the same way); the first chunk planned two
+    frames, of two rows and one row:
+
+    >>> from footfall.planner import merge_harvest_chunks
+    >>> chunks = [{"rows": ["a", "b", "c"], "frame_ends": [2, 3]}, {"rows": ["d", "e"], "frame_ends": [1, 2]}]
+    >>> merge_harvest_chunks(chunks, None)
+    ['a', 'b', 'c', 'd', 'e']
+    >>> merge_harvest_chunks(chunks, 4)   # the total reaches 4 at the end of the second chunk's first frame
+    ['a', 'b', 'c', 'd']
+    >>> merge_harvest_chunks(chunks, 1)                 # whole frames: the first frame's two rows
+    ['a', 'b']
+    """
     rows: list[dict] = []
     for chunk in chunks:
         if max_situations is not None:

@@ -59,13 +59,34 @@ MAX_COORDINATE = 1e12
 class IKResult:
     """CCD solution of B legs with S segments.
 
-    angles:     (B, S + 1) [azimuth, pitch_0, ..., pitch_{S-1}] (rad), within the limits.
-    residual:   (B,) |foot - target| (m) at ``angles``; never NaN.
-    iterations: (B,) CCD sweeps used (0 when the start already was within tolerance).
-    converged:  (B,) residual < tolerance.
-    joints:     (B, S + 2, 3) world positions, one row per angle (its pivot; rows 0 and 1
-                are both the hip), the foot last. ``joints[:, 1:]`` is the polyline
-                hip, knees..., foot.
+    What :func:`solve_legs` returns.
+
+    Attributes
+    ----------
+    angles : ndarray
+        (B, S + 1) [azimuth, pitch_0, ..., pitch_{S-1}] (rad), within the limits.
+    residual : ndarray
+        (B,) |foot - target| (m) at ``angles``; never NaN.
+    iterations : ndarray
+        (B,) CCD sweeps used (0 when the start already was within tolerance).
+    converged : ndarray
+        (B,) residual < tolerance.
+    joints : ndarray
+        (B, S + 2, 3) world positions, one row per angle (its pivot; rows 0 and 1
+        are both the hip), the foot last. ``joints[:, 1:]`` is the polyline
+        hip, knees..., foot.
+    feet : ndarray
+        (B, 3) foot positions, ``joints[:, -1]``.
+
+    Examples
+    --------
+    >>> from footfall.planner import solve_legs
+    >>> result = solve_legs([[0.0, 0.0, 0.0]], [[0.0, 0.0, 0.0]], [0.0], [[0.1, 0.1]],
+    ...                     [[[-1.5, 1.5], [0.0, 2.5]]], 1.2, [[0.1, -0.1, 0.0]])
+    >>> result.angles.shape, result.joints.shape, result.feet.shape   # B = 1 leg, S = 2 segments
+    ((1, 3), (1, 4, 3), (1, 3))
+    >>> result.joints[0, 1:].round(6).tolist()   # hip, knee, foot
+    [[0.0, 0.0, 0.0], [0.1, 0.0, 0.0], [0.1, -0.1, 0.0]]
     """
 
     angles: np.ndarray
@@ -116,6 +137,34 @@ def body_rotation(yaw, pitch=0.0, roll=0.0) -> np.ndarray:
     """(..., 3, 3) R = R_yaw(yaw) @ R_pitch(pitch) @ R_roll(roll) (see :mod:`planner._kernels_ik`).
 
     Columns: the body's forward, up and left axes in world coordinates. The arguments broadcast.
+
+    Parameters
+    ----------
+    yaw : float or array_like
+        Heading (rad) about world up: forward is ``(cos yaw, 0, sin yaw)`` on flat ground.
+    pitch : float or array_like, optional
+        Rotation (rad) about the body's left axis, positive raising the forward axis.
+    roll : float or array_like, optional
+        Rotation (rad) about the body's forward axis, positive raising the left axis.
+
+    Returns
+    -------
+    ndarray
+        (..., 3, 3) rotation matrices, ``...`` the broadcast shape of the arguments.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from footfall.planner import body_rotation
+    >>> bool(np.allclose(body_rotation(0.0), np.eye(3)))
+    True
+    >>> r = body_rotation(np.pi / 2)        # a quarter turn: forward is world +z, left is world -x
+    >>> r[:, 0].round(6).tolist(), r[:, 2].round(6).tolist()
+    ([0.0, 0.0, 1.0], [-1.0, 0.0, 0.0])
+    >>> round(float(body_rotation(0.0, np.pi / 6)[1, 0]), 6)   # pitched up 30 degrees: forward rises by 1/2
+    0.5
+    >>> body_rotation([0.0, 0.1, 0.2], 0.05).shape
+    (3, 3, 3)
     """
     yaw, pitch, roll = np.broadcast_arrays(*(np.asarray(a, dtype=np.float64) for a in (yaw, pitch, roll)))
     cy, sy = np.cos(yaw), np.sin(yaw)
@@ -209,30 +258,78 @@ def solve_legs(hips, body_rotations, rest_azimuths, segment_lengths, limits, azi
                two_bone: bool = False, plane_rolls=None) -> IKResult:
     """CCD inverse kinematics of B legs with S segments, in one kernel call.
 
-    hips:            (B, 3) world hip positions (m).
-    body_rotations:  (B, 3, 3) rotation of each leg's body, or (B, 3) (yaw, pitch, roll) angles.
-    rest_azimuths:   (B,) rest azimuth of each leg in its body frame (rad).
-    segment_lengths: (B, S) m, S >= 2, all > 0.
-    limits:          (B, S, 2) hinge (min, max) (rad), min < max.
-    azimuth_limits:  (B,) or a scalar, >= 0 (rad): |azimuth| <= limit.
-    targets:         (B, 3) world foot targets (m).
-    warm_start:      (B, S + 1) starting angles (e.g. the previous frame's), brought into the
-                     limits first; None: cold start from the grid pose nearest each target.
-    max_iterations:  CCD sweeps per leg (restarts included), >= 0.
-    tolerance:       stop below this residual (m), >= 0.
-    parallel:        spread the legs over the cores (bit-identical to the serial kernel).
-    restarts:        grid restarts after a stalled descent (0: a single descent; with a warm
-                     start that keeps the pose continuous even when the target is out of reach).
-    pair_steps:      add the two-hinge closed-form steps to each sweep (False: plain CCD).
-    two_bone:        the far characters' solve (level of detail): from the warm start (required),
-                     the azimuth and two hinges in closed form, one CCD sweep only where they
-                     cannot reach (:func:`planner._kernels_ik.solve_legs_two_bone_serial`);
-                     ``max_iterations``, ``restarts`` and ``pair_steps`` are not used.
-    plane_rolls:     (B,) bool, the plane joint is an abduction (``CreatureLegs.plane_rolls``);
-                     None: every leg has an azimuth joint.
-
     Never raises for an unreachable or degenerate target: the residual says how far the foot
     stays. Raises ValueError naming the offending argument for bad shapes or values.
+
+    Parameters
+    ----------
+    hips : array_like
+        (B, 3) world hip positions (m).
+    body_rotations : array_like
+        (B, 3, 3) rotation of each leg's body, or (B, 3) (yaw, pitch, roll) angles.
+    rest_azimuths : array_like
+        (B,) rest azimuth of each leg in its body frame (rad).
+    segment_lengths : array_like
+        (B, S) m, S >= 2, all > 0.
+    limits : array_like
+        (B, S, 2) hinge (min, max) (rad), min < max.
+    azimuth_limits : float or array_like
+        (B,) or a scalar, >= 0 (rad): |azimuth| <= limit.
+    targets : array_like
+        (B, 3) world foot targets (m).
+    warm_start : array_like, optional
+        (B, S + 1) starting angles (e.g. the previous frame's), brought into the
+        limits first; None: cold start from the grid pose nearest each target.
+    max_iterations : int, optional
+        CCD sweeps per leg (restarts included), >= 0.
+    tolerance : float, optional
+        Stop below this residual (m), >= 0.
+    parallel : bool, optional
+        Spread the legs over the cores (bit-identical to the serial kernel).
+    restarts : int, optional
+        Grid restarts after a stalled descent (0: a single descent; with a warm
+        start that keeps the pose continuous even when the target is out of reach).
+    pair_steps : bool, optional
+        Add the two-hinge closed-form steps to each sweep (False: plain CCD).
+    two_bone : bool, optional
+        The far characters' solve (level of detail): from the warm start (required),
+        the azimuth and two hinges in closed form, one CCD sweep only where they
+        cannot reach (:func:`planner._kernels_ik.solve_legs_two_bone_serial`);
+        ``max_iterations``, ``restarts`` and ``pair_steps`` are not used.
+    plane_rolls : array_like, optional
+        (B,) bool, the plane joint is an abduction (``CreatureLegs.plane_rolls``);
+        None: every leg has an azimuth joint.
+
+    Returns
+    -------
+    IKResult
+        Angles, residuals, sweeps used, convergence flags and joint positions of the B legs.
+
+    Raises
+    ------
+    ValueError
+        Bad shapes or values (not finite, a segment length <= 0, a hinge min >= max, a
+        negative count or tolerance, ``two_bone`` without ``warm_start``); the message names
+        the argument.
+
+    Examples
+    --------
+    One leg of two 0.1 m segments, hip at the origin, body facing world +x: the target
+    (0.1, -0.1, 0) is reached with the thigh horizontal and the knee bent down a right angle.
+
+    >>> import numpy as np
+    >>> from footfall.planner import solve_legs
+    >>> leg = dict(hips=[[0.0, 0.0, 0.0]], body_rotations=[[0.0, 0.0, 0.0]], rest_azimuths=[0.0],
+    ...            segment_lengths=[[0.1, 0.1]], limits=[[[-1.5, 1.5], [0.0, 2.5]]], azimuth_limits=1.2)
+    >>> result = solve_legs(**leg, targets=[[0.1, -0.1, 0.0]])
+    >>> bool(result.converged[0]), bool(np.allclose(result.angles, [[0.0, 0.0, np.pi / 2]]))
+    (True, True)
+
+    Out of reach, the leg stretches towards the target and the residual says how far it stays:
+
+    >>> far = solve_legs(**leg, targets=[[0.5, 0.0, 0.0]])
+    >>> bool(far.converged[0]), round(float(far.residual[0]), 6), far.feet.round(6).tolist()
+    (False, 0.3, [[0.2, 0.0, 0.0]])
     """
     rest, lengths, lim, az = _leg_statics(rest_azimuths, segment_lengths, limits, azimuth_limits)
     n, s = lengths.shape
@@ -331,6 +428,33 @@ def legs_of(creature, azimuth_limit: float = DEFAULT_AZIMUTH_LIMIT) -> CreatureL
     hip, :data:`UPRIGHT_LEG_OFFSET`) beside the midline (:data:`SIDED_HIP_OFFSET`) gets an
     abduction joint within :data:`ABDUCTION_LIMIT` and a forward-facing plane; one on the
     midline a free azimuth.
+
+    Parameters
+    ----------
+    creature : Creature
+        A :class:`footfall.scenarios.Creature` with L legs of S segments.
+    azimuth_limit : float, optional
+        Limit (rad) of the azimuth joint of the legs that are not upright, finite and >= 0.
+
+    Returns
+    -------
+    CreatureLegs
+        ``hips`` (L, 3), ``rest_azimuths`` (L,), ``segment_lengths`` (L, S), ``limits``
+        (L, S, 2), ``azimuth_limits`` (L,) and ``plane_rolls`` (L,) bool, the arguments of
+        :func:`solve_legs` for one character (its ``world_hips`` gives the world hips).
+
+    Examples
+    --------
+    >>> from footfall.planner import legs_of
+    >>> from footfall.scenarios import load_creature
+    >>> spider = legs_of(load_creature("spider"))
+    >>> spider.n_legs, spider.segment_lengths.shape, spider.limits.shape
+    (8, (8, 4), (8, 4, 2))
+    >>> spider.azimuth_limits.tolist() == [1.2] * 8, bool(spider.plane_rolls.any())   # sprawled legs
+    (True, False)
+    >>> quadruped = legs_of(load_creature("quadruped"))   # upright legs beside the body: abductions
+    >>> quadruped.plane_rolls.tolist(), quadruped.azimuth_limits.tolist()
+    ([True, True, True, True], [0.75, 0.75, 0.75, 0.75])
     """
     try:
         limit = float(azimuth_limit)
@@ -370,6 +494,29 @@ def rest_pose_angles(creature, azimuth_limit: float = DEFAULT_AZIMUTH_LIMIT) -> 
     (so the rest pose is the canonical one); every built-in creature's rest pose is reachable within
     its limits, and its azimuths come out 0 (up to round-off); an abducting leg's plane rolls
     through its rest foot.
+
+    Parameters
+    ----------
+    creature : Creature
+        A :class:`footfall.scenarios.Creature` with L legs of S segments.
+    azimuth_limit : float, optional
+        Limit (rad) of the azimuth joints, as in :func:`legs_of`.
+
+    Returns
+    -------
+    ndarray
+        (L, S + 1) [azimuth, pitch_0, ..., pitch_{S-1}] (rad) of each leg, in leg order.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from footfall.planner import rest_pose_angles
+    >>> from footfall.scenarios import load_creature
+    >>> angles = rest_pose_angles(load_creature("spider"))
+    >>> angles.shape                                # 8 legs of 4 segments
+    (8, 5)
+    >>> bool(np.abs(angles[:, 0]).max() < 1e-9)     # the azimuths come out 0
+    True
     """
     legs = legs_of(creature, azimuth_limit)
     n = legs.n_legs

@@ -47,7 +47,47 @@ LEVEL_NAMES = ("full", "far", "hidden")
 
 @dataclass(frozen=True)
 class LodConfig:
-    """Distances in m; ``max_couples`` couples after the first valid one up close."""
+    """Distances in m; ``max_couples`` couples after the first valid one up close.
+
+    How these distances and counts are used is in the module docstring. Values out of range
+    (``near_m >= far_m``, ``hysteresis_m`` not in ``[0, far_m)``, ``near_slice_m >= far_slice_m``,
+    a negative count ...) raise ValueError naming the field.
+
+    Attributes
+    ----------
+    near_m, far_m : float
+        Camera distances (m) of the full budget and of the first valid couple with no slices;
+        the budget is interpolated linearly in between, and ``far_m`` is where a character
+        moves to ``LEVEL_FAR`` (defaults 2, 12).
+    max_couples : int
+        Couples evaluated after the first valid one at ``near_m`` and nearer (default 8).
+    near_slice_m, far_slice_m : float
+        Slice size (m) at ``near_m``, and the interpolated size beyond which there are no
+        slices (defaults 0.10, 0.30).
+    far_radius_cells, far_margin_cells : int
+        Candidate disc radius and region-of-interest margin (cells) of a far foot's first try
+        (defaults 1, 1).
+    far_fallback_margin_cells : int
+        Region-of-interest margin (cells) of a far foot's full first-valid search (default 6).
+    hysteresis_m : float
+        A character goes back from ``LEVEL_FAR`` to ``LEVEL_FULL`` only at ``far_m -
+        hysteresis_m`` (m) (default 1).
+    moving_box_margin_m : float
+        A character this near (m) a moving box's reach plans on the paper's maps (default 0.3).
+    moving_box_couples : int
+        ... with at least this many couples after the first valid one (default 2).
+
+    Examples
+    --------
+    >>> from footfall.planner import LodConfig
+    >>> config = LodConfig(near_m=1.0, far_m=6.0)
+    >>> config.far_m - config.hysteresis_m   # back to the full level nearer than this (m)
+    5.0
+    >>> LodConfig(near_m=6.0, far_m=6.0)
+    Traceback (most recent call last):
+        ...
+    ValueError: LodConfig.near_m/far_m: expected 0 <= near < far, got 6.0, 6.0
+    """
 
     near_m: float = 2.0
     far_m: float = 12.0

@@ -30,7 +30,35 @@ def _readonly(a: np.ndarray) -> np.ndarray:
 class LocalMaps:
     """A character's local maps. ``elevation`` = top of the highest thing in each cell
     (terrain or box, m); ``ground`` = terrain alone (m); ``forbidden`` = 1 where a
-    forbidden box (or the world's edge) is."""
+    forbidden box (or the world's edge) is.
+
+    Made by :meth:`WorldRaster.local_maps`. A map whose shape is not ``frame.shape``, or a
+    non-finite elevation or ground height, raises ValueError.
+
+    Attributes
+    ----------
+    frame : GridFrame
+        Placement of the maps in the world.
+    elevation : ndarray
+        (R, C) float64, top of the highest thing in each cell (m).
+    ground : ndarray
+        (R, C) float64, terrain height at the cell centres (m).
+    forbidden : ndarray
+        (R, C) uint8, 1 where a forbidden box or the world's edge is.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from footfall.planner import GridFrame, LocalMaps
+    >>> frame = GridFrame(0.0, 0.0, 0.1, 2, 3)
+    >>> maps = LocalMaps(frame, np.zeros((2, 3)), np.zeros((2, 3)), np.zeros((2, 3), np.uint8))
+    >>> maps.elevation.shape
+    (2, 3)
+    >>> LocalMaps(frame, np.zeros((2, 3)), np.zeros((3, 2)), np.zeros((2, 3), np.uint8))
+    Traceback (most recent call last):
+        ...
+    ValueError: LocalMaps.ground: expected shape (2, 3), got (3, 2)
+    """
 
     frame: GridFrame
     elevation: np.ndarray
@@ -49,7 +77,43 @@ class LocalMaps:
 
 @dataclass(frozen=True)
 class WorldRaster:
-    """The static world at the planner's resolution (computed once per scenario)."""
+    """The static world at the planner's resolution (computed once per scenario).
+
+    Build it with :meth:`build`; :meth:`local_maps` cuts a character's maps out of it, with
+    the moving boxes near them drawn at the time asked for.
+
+    Attributes
+    ----------
+    frame : GridFrame
+        The global grid, from the terrain's low-x, low-z corner, of whole cells.
+    ground : ndarray
+        (R, C) terrain height at the cell centres (m), read-only.
+    static_top : ndarray
+        (R, C) ground raised by the tops of the static boxes (m), read-only.
+    static_forbidden : ndarray
+        (R, C) uint8, 1 where a static forbidden box overlaps the cell, read-only.
+    obstacles : Obstacles
+        The scenario's boxes, static and moving (:class:`footfall.scenarios.Obstacles`).
+
+    Examples
+    --------
+    A 2 m x 2 m flat ground in cells of 0.1 m, and a forbidden box 0.3 m wide and 0.2 m
+    high in its middle: the box overlaps 4 x 4 cells.
+
+    >>> from footfall.planner import WorldRaster
+    >>> from footfall.scenarios import Obstacles, flat_heightfield
+    >>> box = Obstacles(centres=[[0.0, 0.1, 0.0]], sizes=[[0.3, 0.2, 0.3]], yaws=[0.0], forbidden=[True])
+    >>> world = WorldRaster.build(flat_heightfield((2.0, 2.0), 0.1), box, cell_size=0.1)
+    >>> world.frame.shape, float(world.static_top.max()), int(world.static_forbidden.sum())
+    ((20, 20), 0.2, 16)
+
+    The 8 x 8 maps of a character near the world's edge at x = 1 m: the columns past it are
+    forbidden.
+
+    >>> maps = world.local_maps(0.95, 0.0, map_cells=8)
+    >>> maps.forbidden.shape, maps.forbidden.sum(axis=0).tolist()
+    ((8, 8), [0, 0, 0, 0, 0, 8, 8, 8])
+    """
 
     frame: GridFrame
     ground: np.ndarray  # (R, C) terrain height at cell centres, m
@@ -59,7 +123,30 @@ class WorldRaster:
 
     @classmethod
     def build(cls, terrain, obstacles, cell_size: float) -> "WorldRaster":
-        """Rasterise ``terrain`` (a Heightfield) and the static ``obstacles``."""
+        """Rasterise ``terrain`` (a Heightfield) and the static ``obstacles``.
+
+        Parameters
+        ----------
+        terrain : Heightfield
+            The ground (:class:`footfall.scenarios.Heightfield`).
+        obstacles : Obstacles
+            The boxes; only the static ones are drawn, the moving ones by :meth:`local_maps`.
+        cell_size : float
+            Side of a cell (m); the grid covers whole cells of the terrain's extent.
+
+        Returns
+        -------
+        WorldRaster
+            The rasterised static world.
+
+        Examples
+        --------
+        >>> from footfall.planner import WorldRaster
+        >>> from footfall.scenarios import Obstacles, flat_heightfield
+        >>> world = WorldRaster.build(flat_heightfield((2.0, 1.0), 0.1), Obstacles.empty(), 0.25)
+        >>> world.frame.shape, (world.frame.origin_x, world.frame.origin_z)   # rows along z
+        ((4, 8), (-1.0, -0.5))
+        """
         x0, x1 = terrain.x_range
         z0, z1 = terrain.z_range
         n_cols = max(1, int(math.floor((x1 - x0) / cell_size)))
@@ -83,7 +170,35 @@ class WorldRaster:
         return cls(frame, _readonly(ground), _readonly(top), _readonly(forbidden), obstacles)
 
     def local_maps(self, centre_x: float, centre_z: float, t: float = 0.0, map_cells: int = 70) -> LocalMaps:
-        """The ``map_cells`` x ``map_cells`` maps centred on (centre_x, centre_z) at time t."""
+        """The ``map_cells`` x ``map_cells`` maps centred on (centre_x, centre_z) at time t.
+
+        The window shares the global grid's cell boundaries; cells past the world's edge are
+        forbidden, and the moving boxes whose bounding circle comes near the window are drawn
+        where they are at ``t``.
+
+        Parameters
+        ----------
+        centre_x, centre_z : float
+            World position (m) the maps are centred on (cell ``map_cells // 2`` holds it).
+        t : float, optional
+            Time (s) at which the moving boxes are drawn.
+        map_cells : int, optional
+            Cells per side of the maps (``PlannerConfig.map_cells``).
+
+        Returns
+        -------
+        LocalMaps
+            The character's maps.
+
+        Examples
+        --------
+        >>> from footfall.planner import WorldRaster
+        >>> from footfall.scenarios import Obstacles, flat_heightfield
+        >>> world = WorldRaster.build(flat_heightfield((2.0, 2.0), 0.1), Obstacles.empty(), 0.1)
+        >>> maps = world.local_maps(0.0, 0.0, map_cells=4)
+        >>> round(maps.frame.origin_x, 6), maps.frame.shape, int(maps.forbidden.sum())
+        (-0.2, (4, 4), 0)
+        """
         f = self.frame
         cell = f.cell_size
         half = map_cells // 2

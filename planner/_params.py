@@ -27,7 +27,47 @@ import numpy as np
 
 @dataclass(frozen=True)
 class PlannerConfig:
-    """Static planner parameters. Units: metres, cells, counts."""
+    """Static planner parameters. Units: metres, cells, counts.
+
+    The module docstring is the tuning guide. An integer field that is not an integer or
+    below its least value, or a length that is not a finite positive number, raises
+    ValueError naming the field.
+
+    Attributes
+    ----------
+    map_cells : int
+        Cells per side of the local obstacles' and elevations' maps, >= 3 (default 70).
+    cell_size : float
+        Side of a map cell (m), > 0 (default 0.07).
+    search_radius_m : float
+        Radius of the candidate-footprint disc (m), > 0 (default 0.25).
+    roi_margin_cells : int
+        Cells added around the source and the candidates for the wavefront, >= 0 (default 6).
+    potential_range_m : float
+        Distance to a blocked cell where the potential vanishes (m), > 0 (default 0.14).
+    potential_gain : float
+        Extra cost factor of a move right next to a blocked cell, >= 0 (default 2).
+    obstacle_margin_m : float
+        Least clearance of a swing above the dilated elevation (m), >= 0 (default 0.01).
+    trajectory_samples : int
+        Samples of the chosen trajectory at constant arc-length spacing, >= 2 (default 32).
+    slice_epsilon_m : float
+        Heights above the terrain below this are terrain, not obstacles (m), > 0
+        (default 0.001).
+
+    Examples
+    --------
+    >>> from footfall.planner import PlannerConfig
+    >>> config = PlannerConfig()
+    >>> round(config.map_cells * config.cell_size, 2)   # side of the local map (m), paper §7
+    4.9
+    >>> config.to_array().shape                        # the floats the kernels read
+    (8,)
+    >>> PlannerConfig(map_cells=2)
+    Traceback (most recent call last):
+        ...
+    ValueError: PlannerConfig.map_cells: expected an integer >= 3, got 2
+    """
 
     map_cells: int = 70  # cells per side of the local obstacles' and elevations' maps
     cell_size: float = 0.07  # m, side of a map cell
@@ -73,16 +113,33 @@ C_CELL, C_RADIUS, C_MARGIN, C_POT_RANGE, C_POT_GAIN, C_OBST_MARGIN, C_SAMPLES, C
 class SearchBudget:
     """How much of the couple search to do (paper §6, LOD).
 
-    couples_after_first:
+    ``FIRST_VALID``, ``DEFAULT_BUDGET`` and ``EXHAUSTIVE`` are the three usual budgets. A
+    negative or non-integer ``couples_after_first`` or a ``slice_size_m`` that is not a
+    positive number raises ValueError.
+
+    Attributes
+    ----------
+    couples_after_first : int or None
         3D couples evaluated after the first valid one; ``None`` = no limit.
-        ``0`` is the off-screen mode: the first valid couple wins.
-    slice_size_m:
+        ``0`` is the off-screen mode: the first valid couple wins (default 6).
+    slice_size_m : float or None
         Height of the elevation slices (m) used to decide between going over and
-        around obstacles; ``None`` = no slices (go over everything not forbidden).
-    paper_early_stop:
+        around obstacles; ``None`` = no slices (go over everything not forbidden)
+        (default 0.10).
+    paper_early_stop : bool
         Stop as soon as a target's best couple does not beat the best so far
         (paper §5.2). Off for the exhaustive search, which only stops when no
-        remaining couple can win (an exact bound).
+        remaining couple can win (an exact bound) (default True).
+
+    Examples
+    --------
+    >>> from footfall.planner import EXHAUSTIVE, FIRST_VALID, SearchBudget
+    >>> SearchBudget().kernel_args()      # (couples after the first, slice size m, early stop)
+    (6, 0.1, True)
+    >>> FIRST_VALID.kernel_args()         # None is passed to the kernels as -1
+    (0, -1.0, True)
+    >>> EXHAUSTIVE.kernel_args()
+    (-1, 0.05, False)
     """
 
     couples_after_first: int | None = 6

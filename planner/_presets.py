@@ -33,6 +33,29 @@ _TOP_FIELDS = {"schema_version", "creature", "gait", "weights", "timing", "prove
 
 @dataclass(frozen=True)
 class Preset:
+    """A validated weight preset, as :func:`load_preset` reads it (schema in the module docstring).
+
+    Attributes
+    ----------
+    creature : str
+        Name of the creature the preset was made for.
+    weights : ScoringWeights
+        The scoring weights.
+    timing : GaitTiming or None
+        The gait timing, or None when the file has none.
+    gait : str or None
+        Name of the gait the preset was made with, or None.
+    provenance : dict
+        Free-form record of how the preset was made (empty when the file has none).
+
+    Examples
+    --------
+    >>> from footfall.planner import GaitTiming, Preset, ScoringWeights
+    >>> preset = Preset("spider", ScoringWeights(), GaitTiming(), None, {})
+    >>> preset.creature, preset.timing.duty_min
+    ('spider', 0.5)
+    """
+
     creature: str
     weights: ScoringWeights
     timing: object | None  # planner._timing.GaitTiming
@@ -59,7 +82,44 @@ def _numbers(path, section: str, values, fields: tuple[str, ...]) -> dict[str, f
 
 
 def load_preset(path: str | Path, creature: str | None = None) -> Preset:
-    """Read and validate a preset; with ``creature``, refuse a preset made for another one."""
+    """Read and validate a preset; with ``creature``, refuse a preset made for another one.
+
+    Parameters
+    ----------
+    path : str or Path
+        The preset's JSON file (schema in the module docstring); the shipped ones are in
+        ``footfall.tuning.PRESETS_DIR``.
+    creature : str, optional
+        Name of the creature the preset must be for; None accepts any.
+
+    Returns
+    -------
+    Preset
+        The creature's name, the weights, the timing (None when the file has none), the gait's
+        name (or None) and the provenance (``{}`` when the file has none).
+
+    Raises
+    ------
+    InputError
+        The file is missing, unreadable or not JSON, a field is missing, unknown or of the
+        wrong type or value, the schema version is not :data:`PRESET_SCHEMA_VERSION`, or the
+        preset is for another creature than ``creature``; the message names the file and the
+        field.
+
+    Examples
+    --------
+    >>> from footfall.planner import ScoringWeights, load_preset
+    >>> from footfall.tuning import PRESETS_DIR
+    >>> preset = load_preset(PRESETS_DIR / "spider.json", creature="spider")
+    >>> preset.creature, preset.gait
+    ('spider', 'spider-metachronal-wave')
+    >>> isinstance(preset.weights, ScoringWeights)
+    True
+    >>> load_preset(PRESETS_DIR / "spider.json", creature="ant")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+        ...
+    footfall._errors.InputError: .../spider.json: creature: preset is for 'spider', not 'ant'
+    """
     from footfall.planner._timing import GaitTiming
 
     path = Path(path)
@@ -110,6 +170,42 @@ def load_preset(path: str | Path, creature: str | None = None) -> Preset:
 
 def preset_dict(creature: str, weights: ScoringWeights, timing=None, gait: str | None = None,
                 provenance: dict | None = None) -> dict:
+    """The JSON object of a preset (schema version :data:`PRESET_SCHEMA_VERSION`), ready for
+    ``json.dumps``; :func:`load_preset` reads the file back.
+
+    Parameters
+    ----------
+    creature : str
+        Name of the creature the preset is for.
+    weights : ScoringWeights
+        The scoring weights (every field is written).
+    timing : GaitTiming, optional
+        The gait timing; None leaves the ``"timing"`` section out.
+    gait : str, optional
+        Name of the gait; None leaves the ``"gait"`` field out.
+    provenance : dict, optional
+        Free-form record of how the preset was made; None writes ``{}``.
+
+    Returns
+    -------
+    dict
+        ``schema_version``, ``creature``, ``weights`` (a dict of floats), and ``gait``,
+        ``timing`` (a dict of floats) when given, and ``provenance``.
+
+    Examples
+    --------
+    >>> import json, pathlib, tempfile
+    >>> from footfall.planner import GaitTiming, ScoringWeights, load_preset, preset_dict
+    >>> data = preset_dict("spider", ScoringWeights(footprint_distance=4.0), timing=GaitTiming())
+    >>> sorted(data), data["weights"]["footprint_distance"]
+    (['creature', 'provenance', 'schema_version', 'timing', 'weights'], 4.0)
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = pathlib.Path(folder) / "mine.json"
+    ...     _ = path.write_text(json.dumps(data))
+    ...     preset = load_preset(path, creature="spider")
+    >>> preset.weights == ScoringWeights(footprint_distance=4.0), preset.timing == GaitTiming()
+    (True, True)
+    """
     out = {"schema_version": PRESET_SCHEMA_VERSION, "creature": creature, "weights": weights.to_dict()}
     if gait is not None:
         out["gait"] = gait

@@ -29,14 +29,42 @@ def _vec(name: str, value, n: int) -> np.ndarray:
 class FootQuery:
     """What the planner needs to know about one foot (world coordinates, metres).
 
-    source:       (x, y, z) where the foot is now.
-    preferred:    (x, z) preferred footprint from the character controller.
-    hip:          (x, z) of this leg's hip (for reach and crossings).
-    reach_xz:     horizontal reach of the leg from its hip.
-    step_height:  preferred step height of the swing.
-    foot_length, foot_width, foot_yaw: the foot rectangle (length along foot_yaw,
-                  radians, world yaw convention (cos, sin) in (x, z)).
-    other_legs:   (M, 4) rows (hip_x, hip_z, foot_x, foot_z) of the other legs.
+    The values are checked and cast when the query is made: the points become float64 arrays,
+    and a wrong shape, a non-finite number or a length that is not positive raises
+    ``ValueError``.
+
+    Attributes
+    ----------
+    source : ndarray, shape (3,)
+        (x, y, z) where the foot is now.
+    preferred : ndarray, shape (2,)
+        (x, z) preferred footprint from the character controller.
+    hip : ndarray, shape (2,)
+        (x, z) of this leg's hip (for reach and crossings).
+    reach_xz : float
+        Horizontal reach of the leg from its hip, m (> 0).
+    step_height : float
+        Preferred step height of the swing, m.
+    foot_length, foot_width, foot_yaw : float
+        The foot rectangle: length and width in m (> 0), the length along ``foot_yaw``
+        (radians, world yaw convention: direction (cos, sin) in (x, z)).
+    other_legs : ndarray, shape (M, 4)
+        Rows (hip_x, hip_z, foot_x, foot_z) of the other legs; none by default.
+
+    Examples
+    --------
+    >>> from footfall.planner import FootQuery
+    >>> query = FootQuery(source=(1.2, 0.0, 1.2), preferred=(1.4, 1.2), hip=(1.1, 1.1), reach_xz=0.5,
+    ...                   step_height=0.05, foot_length=0.03, foot_width=0.02, foot_yaw=0.0)
+    >>> query.source, query.other_legs.shape
+    (array([1.2, 0. , 1.2]), (0, 4))
+    >>> round(query.feet_block_radius, 4)       # hypot(0.03, 0.02): other feet keep this far away
+    0.0361
+    >>> FootQuery(source=(1.2, 0.0), preferred=(1.4, 1.2), hip=(1.1, 1.1), reach_xz=0.5, step_height=0.05,
+    ...           foot_length=0.03, foot_width=0.02, foot_yaw=0.0)
+    Traceback (most recent call last):
+    ...
+    ValueError: FootQuery.source: expected 3 finite numbers, got (1.2, 0.0)
     """
 
     source: np.ndarray
@@ -78,6 +106,54 @@ class CoupleResult:
 
     ``valid`` False means no couple exists: the foot holds (``target`` = source and
     ``trajectory`` repeats it).
+
+    Attributes
+    ----------
+    valid : bool
+        A couple was found.
+    target_cell : tuple of int
+        (row, col) of the footprint's cell in the local maps.
+    target : ndarray, shape (3,)
+        The footprint, world (x, y, z).
+    slice_index : int
+        The elevation slice the trajectory was planned in: 0 is no slices (over everything),
+        higher indices ever lower levels that go around ever more obstacles.
+    slice_level_m : float
+        Height above the terrain of that slice, m; ``inf`` = no slices (the swing goes over
+        everything).
+    couple_score, footprint_score, trajectory_score : float
+        The couple's score and its two halves, in [0, 1].
+    breakdown : dict of str to float
+        Goodness in [0, 1] per criterion, keys :data:`SCORE_TERMS`.
+    metrics : dict of str to float
+        The trajectory's raw metrics, keys :data:`RAW_METRICS` (``length_m``, ``clearance_m``...).
+    counters : dict of str to int
+        The search's work, keys :data:`COUNTERS` (couples evaluated, cells expanded...).
+    trajectory : ndarray, shape (K, 3)
+        Samples at constant arc length from the source to the target
+        (K = ``PlannerConfig.trajectory_samples``).
+    candidate_cells : ndarray, shape (n, 2)
+        The candidate footprints' local (row, col), by descending footprint score.
+    candidate_scores : ndarray, shape (n,)
+        Their footprint scores.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from footfall.planner import COUNTERS, FootQuery, GridFrame, LocalMaps, plan_foot
+    >>> flat = np.zeros((35, 35))                   # 35 x 35 cells of 7 cm, flat ground at y = 0
+    >>> maps = LocalMaps(GridFrame(0.0, 0.0, 0.07, 35, 35), flat, flat, np.zeros((35, 35), np.uint8))
+    >>> query = FootQuery(source=(1.2, 0.0, 1.2), preferred=(1.4, 1.2), hip=(1.1, 1.1), reach_xz=0.5,
+    ...                   step_height=0.05, foot_length=0.03, foot_width=0.02, foot_yaw=0.0)
+    >>> result = plan_foot(maps, query)
+    >>> result.valid, result.target
+    (True, array([1.4, 0. , 1.2]))
+    >>> round(result.metrics["length_m"], 3)        # a straight 20 cm step on flat ground
+    0.2
+    >>> list(result.counters) == list(COUNTERS)
+    True
+    >>> result.candidate_cells.shape[0] == result.candidate_scores.size
+    True
     """
 
     valid: bool
@@ -110,7 +186,63 @@ def plan_foot(maps: LocalMaps, query: FootQuery, weights: ScoringWeights | None 
               budget: SearchBudget = DEFAULT_BUDGET, config: PlannerConfig | None = None,
               mode: str = "search") -> CoupleResult:
     """Best footprint-trajectory couple for one foot (paper §5.2). Never raises for a
-    boxed-in foot: the result is then ``valid=False``."""
+    boxed-in foot: the result is then ``valid=False``.
+
+    Parameters
+    ----------
+    maps : LocalMaps
+        The character's local maps; their cell size must be ``config.cell_size`` and they must
+        contain ``query.source``.
+    query : FootQuery
+        The foot: where it is, its preferred footprint, its leg and the other legs.
+    weights : ScoringWeights, optional
+        The criteria's weights; default ``ScoringWeights()``.
+    budget : SearchBudget, optional
+        How much of the search to run (couples after the first valid one, slice size, the
+        paper's early stop); default :data:`DEFAULT_BUDGET`.
+    config : PlannerConfig, optional
+        Static planner parameters; default ``PlannerConfig()`` (7 cm cells).
+    mode : {"search", "per_target", "brute_force"}, optional
+        ``"search"``: the runtime's search (one wavefront per slice); ``"per_target"``: the same
+        search with one wavefront per (target, slice), for benchmarks; ``"brute_force"``: every
+        (target, slice) couple scored in 3D with no pruning, the reference the tests compare
+        the search with.
+
+    Returns
+    -------
+    CoupleResult
+        The chosen couple, its scores, goodnesses, raw metrics and counters.
+
+    Raises
+    ------
+    ValueError
+        For an unknown ``mode``, maps whose cell size differs from ``config.cell_size``, or a
+        source outside the maps.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from footfall.planner import FootQuery, GridFrame, LocalMaps, plan_foot
+    >>> flat = np.zeros((35, 35))                   # 35 x 35 cells of 7 cm, flat ground at y = 0
+    >>> maps = LocalMaps(GridFrame(0.0, 0.0, 0.07, 35, 35), flat, flat, np.zeros((35, 35), np.uint8))
+    >>> query = FootQuery(source=(1.2, 0.0, 1.2), preferred=(1.4, 1.2), hip=(1.1, 1.1), reach_xz=0.5,
+    ...                   step_height=0.05, foot_length=0.03, foot_width=0.02, foot_yaw=0.0)
+    >>> result = plan_foot(maps, query)
+    >>> result.valid, result.target                 # on open flat ground the preferred footprint wins
+    (True, array([1.4, 0. , 1.2]))
+    >>> result.trajectory.shape                     # source -> target, PlannerConfig.trajectory_samples
+    (32, 3)
+    >>> round(result.couple_score, 3), result.breakdown["distance"]
+    (0.964, 1.0)
+
+    A foot boxed in by forbidden cells holds:
+
+    >>> walled = np.ones((35, 35), np.uint8)
+    >>> walled[17, 17] = 0                          # forbidden everywhere but the foot's own cell
+    >>> held = plan_foot(LocalMaps(maps.frame, flat, flat, walled), query)
+    >>> held.valid, held.target
+    (False, array([1.2, 0. , 1.2]))
+    """
     weights = weights or ScoringWeights()
     config = config or PlannerConfig()
     if mode not in MODES:
@@ -139,6 +271,43 @@ def wavefront_distances(passable, source: tuple[int, int], cell_size: float = 1.
     ``cost_factor`` (same shape, >= 1) multiplies the cost of entering a cell (the
     potential field); unreached cells are inf. With ``targets`` ((k, 2) cells) the
     wavefront stops once they are all settled; otherwise it covers the grid.
+
+    Parameters
+    ----------
+    passable : array_like of bool, shape (H, W)
+        Cells a path may enter.
+    source : tuple of int
+        (row, col) the wavefront starts from (cost 0).
+    cell_size : float, optional
+        Side of a cell: a straight move costs ``cell_size``, a diagonal one ``sqrt(2) * cell_size``.
+    cost_factor : array_like of float, shape (H, W), optional
+        Factor on the cost of entering each cell (positive and finite; the planner's are >= 1).
+    targets : array_like of int, shape (k, 2), optional
+        (row, col) cells after whose settling the wavefront stops; cells not settled by then
+        hold provisional costs (or ``inf``). A target that is not passable is reached but never
+        passed through.
+
+    Returns
+    -------
+    ndarray of float, shape (H, W)
+        The least cost of a path from ``source`` to each cell, ``inf`` where none exists.
+
+    Raises
+    ------
+    ValueError
+        For a grid that is not 2-D, a source outside it, or a malformed ``cost_factor``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from footfall.planner import wavefront_distances
+    >>> passable = np.ones((3, 4), bool)
+    >>> passable[:, 2] = False                      # a wall across column 2
+    >>> d = wavefront_distances(passable, (0, 0), cell_size=0.5)
+    >>> float(d[2, 0]), round(float(d[1, 1]), 4)    # two straight moves; one diagonal move
+    (1.0, 0.7071)
+    >>> bool(np.isinf(d[:, 2:]).all())              # the wall and the cells behind it are unreached
+    True
     """
     passable = np.asarray(passable, dtype=bool)
     if passable.ndim != 2:

@@ -37,6 +37,66 @@ RECORDING_VERSION = 1
 
 @dataclass(frozen=True)
 class SimulationSummary:
+    """What :func:`simulate` measured over a run: counts, safety and gait metrics, timings.
+
+    The metrics are defined in the docstring of ``footfall.planner._simulation`` and in the
+    README (``footfall simulate --json`` prints these fields, :meth:`to_json`); a recording's
+    header carries them too.
+
+    Attributes
+    ----------
+    frames, characters, steps : int
+        Frames run, characters, footsteps taken (touch-downs).
+    collisions, forbidden_footprints, leg_crossings, body_overlaps, shared_foot_spots : int
+        Safety counts (on the rendered pose, :class:`planner._counters.FrameCounters`).
+    unavoidable_contacts : int
+        Feet inside a box too fast to escape (not counted as collisions).
+    max_stance_slip_m, ik_residual_p95_m : float
+        m: the largest distance of a stance foot from its touch-down point; the IK residual's
+        95th percentile.
+    stuck_seconds : float
+        Character-seconds in which a character short of its goal moved less than 10 % of its
+        asked speed over the last 2 s.
+    ms_per_frame_median, ms_per_frame_mean : float
+        Frame times, ms (the mean includes the first frame).
+    ms_per_frame_warmup, ms_per_frame_steady : float or None
+        ms of the first frame, where a fresh process loads or compiles the numba kernels, and
+        the mean of the others (None for a one-frame run).
+    stage_ms_median : dict of str to float
+        Median ms of each stage of :func:`step`.
+    plans, holds, replans, cells_expanded, couples_evaluated : int
+        The planner's work: feet planned, new requests held for want of a couple, re-plans,
+        wavefront cells expanded, couples scored.
+    finite : bool
+        Every pose of the run was finite.
+    stride_rel_error_median, stride_rel_error_p90 : float or None
+        Per-stride error against the stride law over the steady strides (None: none measured).
+    strides_measured : int
+        The steady strides measured.
+    speed_asked, speed_cap, speed_reached : float
+        m/s: the scenario's speed, the legs' cap (None: no cap) and the median speed reached.
+    duty_factor_mean : float or None
+        Stance fraction of the walking characters' foot-frames after the first second.
+    gait_fractions : dict of str to float
+        Share of character-frames in each gait of the creature's schedule.
+    lod_levels : dict or None
+        With a LOD mode, the quality of each level of detail (``planner._lod_quality``), the
+        largest jump of a rendered foot at a level switch (``pop_max_m``) and the ``switches``;
+        None with LOD off.
+
+    Examples
+    --------
+    >>> from footfall.planner import init_crowd, simulate
+    >>> from footfall.scenarios import default_gait, load_creature, load_scenario
+    >>> scenario = load_scenario("flat"); spider = load_creature("spider")
+    >>> model, state = init_crowd(scenario, spider, default_gait(spider), n_characters=2, seed=0)
+    >>> summary = simulate(model, state, 5)
+    >>> summary.frames, summary.characters, summary.finite, summary.collisions
+    (5, 2, True, 0)
+    >>> summary.to_json()["frames"], summary.gait_fractions
+    (5, {'spider-metachronal-wave': 1.0})
+    """
+
     frames: int
     characters: int
     steps: int
@@ -80,7 +140,54 @@ class SimulationSummary:
 
 
 class Recorder:
-    """Per-frame arrays (float32) and planning events, saved as one .npz."""
+    """Per-frame arrays (float32) and planning events, saved as one .npz.
+
+    Give it to :func:`simulate`, which calls :meth:`capture` after every frame; then
+    :meth:`save` writes the file (format ``footfall-recording``, :data:`RECORDING_VERSION`).
+
+    Parameters
+    ----------
+    model : CrowdModel
+        The crowd's static part.
+    state : CrowdState
+        Its state before the first frame (for the arrays' shapes).
+    frames : int
+        Frames to record.
+
+    Attributes
+    ----------
+    frames : int
+        Frames the arrays hold.
+    arrays : dict of str to ndarray
+        One array per quantity, first axis the frame: ``pelvis`` (frames, C, 3), ``orientation``
+        (heading, pitch, roll), ``feet`` (frames, C, L, 3), ``in_stance``, ``swing_phase``,
+        ``joint_angles``, ``ik_on``, ``foot_yaw``, ``speed``, ``stage_seconds`` and, with a LOD
+        level, ``lod_level``.
+    events : list of ndarray
+        One row per planned foot: frame, character, leg, kind, valid, target, scores, goodnesses,
+        counters, slice level (the columns the header names).
+
+    Examples
+    --------
+    >>> import json, os, tempfile
+    >>> import numpy as np
+    >>> from footfall.planner import Recorder, init_crowd, simulate
+    >>> from footfall.scenarios import default_gait, load_creature, load_scenario
+    >>> scenario = load_scenario("flat"); spider = load_creature("spider")
+    >>> model, state = init_crowd(scenario, spider, default_gait(spider), n_characters=2, seed=0)
+    >>> recorder = Recorder(model, state, 5)
+    >>> summary = simulate(model, state, 5, recorder=recorder)
+    >>> recorder.arrays["pelvis"].shape, recorder.arrays["feet"].shape
+    ((5, 2, 3), (5, 2, 8, 3))
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = os.path.join(folder, "run.npz")
+    ...     recorder.save(path, model, summary, {"scenario": "flat"})
+    ...     with np.load(path) as recording:
+    ...         header = json.loads(str(recording["header"]))
+    ...         shape = recording["in_stance"].shape
+    >>> header["format"], header["scenario"], shape
+    ('footfall-recording', 'flat', (5, 2, 8))
+    """
 
     def __init__(self, model: CrowdModel, state: CrowdState, frames: int):
         c, l = state.in_stance.shape
@@ -153,7 +260,41 @@ def realised_strides(feet, in_stance, pelvis, dt: float):
     """(speed (n,), stride (n,)) of every pair of consecutive touch-downs of the same foot, from
     per-frame arrays (frames, C, L, 3) feet, (frames, C, L) in_stance and (frames, C, 3) pelvis:
     stride = horizontal distance between the two footprints (one cycle of that foot), speed =
-    the pelvis's horizontal displacement over the same frames / their duration (m/s)."""
+    the pelvis's horizontal displacement over the same frames / their duration (m/s).
+
+    Parameters
+    ----------
+    feet : ndarray, shape (frames, C, L, 3)
+        Foot positions per frame (a recording's ``feet``).
+    in_stance : ndarray of bool, shape (frames, C, L)
+        The feet on the ground per frame.
+    pelvis : ndarray, shape (frames, C, 3)
+        Pelvis positions per frame.
+    dt : float
+        s between two frames.
+
+    Returns
+    -------
+    speed : ndarray, shape (n,)
+        m/s, the pelvis's mean ground speed over each stride.
+    stride : ndarray, shape (n,)
+        m, each stride's length, sorted by character, leg, then frame.
+
+    Examples
+    --------
+    One foot touching down at frames 2 and 4, half a second apart, while the pelvis moves
+    0.125 m a frame:
+
+    >>> import numpy as np
+    >>> from footfall.planner import realised_strides
+    >>> feet = np.zeros((5, 1, 1, 3))
+    >>> feet[:, 0, 0, 0] = [0.0, 0.0, 0.5, 0.5, 1.0]
+    >>> in_stance = np.array([True, False, True, False, True]).reshape(5, 1, 1)
+    >>> pelvis = np.zeros((5, 1, 3))
+    >>> pelvis[:, 0, 0] = 0.125 * np.arange(5)
+    >>> realised_strides(feet, in_stance, pelvis, dt=0.5)   # 0.25 m in 1 s; a 0.5 m stride
+    (array([0.25]), array([0.5]))
+    """
     down = in_stance[1:] & ~in_stance[:-1]  # touched down at frame k + 1
     frames, chars, legs = np.nonzero(down)
     order = np.lexsort((frames, legs, chars))
@@ -167,7 +308,31 @@ def realised_strides(feet, in_stance, pelvis, dt: float):
 
 def asked_speed(model: CrowdModel, state: CrowdState) -> np.ndarray:
     """(C,) m/s: the speed asked of each character, capped where even the least duty factor does not fit
-    its legs' stance windows (``model.speed_cap``): what the stride and speed bars are measured against."""
+    its legs' stance windows (``model.speed_cap``): what the stride and speed bars are measured against.
+
+    Parameters
+    ----------
+    model : CrowdModel
+        The crowd's static part (its ``speed_cap``).
+    state : CrowdState
+        The crowd (its ``desired_speed``).
+
+    Returns
+    -------
+    ndarray, shape (C,)
+        m/s.
+
+    Examples
+    --------
+    >>> from footfall.planner import asked_speed, init_crowd
+    >>> from footfall.scenarios import default_gait, load_creature, load_scenario
+    >>> scenario = load_scenario("flat"); spider = load_creature("spider")
+    >>> model, state = init_crowd(scenario, spider, default_gait(spider), n_characters=2, seed=0)
+    >>> asked_speed(model, state)                   # the flat scenario's 0.3 m/s: far under the cap
+    array([0.3, 0.3])
+    >>> model.speed_cap > 0.3
+    True
+    """
     return np.minimum(state.desired_speed, model.speed_cap)
 
 
@@ -227,7 +392,32 @@ class StrideMeter:
 
 
 def arrived(model: CrowdModel, state: CrowdState) -> np.ndarray:
-    """(C,) characters within ``arrive_radius`` of the last point of their route."""
+    """(C,) characters within ``arrive_radius`` of the last point of their route.
+
+    Parameters
+    ----------
+    model : CrowdModel
+        The crowd's static part (``model.controller.arrive_radius``).
+    state : CrowdState
+        The crowd (pelvis, route and route index).
+
+    Returns
+    -------
+    ndarray of bool, shape (C,)
+        The characters on the last leg of their route and within the arrive radius of its end.
+
+    Examples
+    --------
+    >>> from footfall.planner import arrived, init_crowd
+    >>> from footfall.scenarios import default_gait, load_creature, load_scenario
+    >>> scenario = load_scenario("flat"); spider = load_creature("spider")
+    >>> model, state = init_crowd(scenario, spider, default_gait(spider), n_characters=2, seed=0)
+    >>> arrived(model, state)
+    array([False, False])
+    >>> state.pelvis[0, [0, 2]] = state.route[0, -1]   # put character 0 on its goal (one waypoint here)
+    >>> arrived(model, state)
+    array([ True, False])
+    """
     last = state.route.shape[1] - 1
     goal = state.route[:, last]
     near = np.hypot(*(state.pelvis[:, [0, 2]] - goal).T) < model.controller.arrive_radius
@@ -250,7 +440,43 @@ def simulate(model: CrowdModel, state: CrowdState, frames: int, recorder: Record
     """Run ``frames`` steps; never raises on a foot that cannot step (it holds).
 
     ``progress(done)`` is called after each frame with the frames done; ``on_step(done, record)`` also
-    gets what the step did (planner._crowd.StepRecord: its timings and the feet it planned)."""
+    gets what the step did (planner._crowd.StepRecord: its timings and the feet it planned).
+
+    The metrics (module docstring) are measured after each frame, outside the frame times.
+
+    Parameters
+    ----------
+    model : CrowdModel
+        The crowd's static part.
+    state : CrowdState
+        Advanced in place by ``frames`` steps.
+    frames : int
+        Frames to run.
+    recorder : Recorder, optional
+        Captures every frame.
+    progress : callable, optional
+        ``progress(done)``.
+    on_step : callable, optional
+        ``on_step(done, record)``, ``record`` a :class:`StepRecord`.
+
+    Returns
+    -------
+    SimulationSummary
+        What the run measured.
+
+    Examples
+    --------
+    >>> from footfall.planner import init_crowd, simulate
+    >>> from footfall.scenarios import default_gait, load_creature, load_scenario
+    >>> scenario = load_scenario("flat"); spider = load_creature("spider")
+    >>> model, state = init_crowd(scenario, spider, default_gait(spider), n_characters=2, seed=0)
+    >>> done = []
+    >>> summary = simulate(model, state, 5, progress=done.append)
+    >>> done, state.frame
+    ([1, 2, 3, 4, 5], 5)
+    >>> summary.frames, summary.characters, summary.finite, summary.collisions, summary.speed_asked
+    (5, 2, True, 0, 0.3)
+    """
     frame_ms = np.zeros(frames)
     stage_s = np.zeros((frames, len(STAGES)))
     counters = FrameCounters(model, state)

@@ -40,7 +40,15 @@ def single_threaded():
     costs more than it saves (x20 on a busy 2-core machine), and one thread leaves the other cores
     to the other tasks of a sweep. Results do not depend on it.
 
+    Yields
+    ------
+    None
+        The block runs with ``numba.get_num_threads() == 1``.
+
+    Examples
+    --------
     >>> import numba
+    >>> from footfall.planner import single_threaded
     >>> before = numba.get_num_threads()
     >>> with single_threaded():
     ...     numba.get_num_threads()

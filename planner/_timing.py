@@ -61,19 +61,94 @@ GRAVITY = 9.81
 
 @register_jitable
 def froude_law(v, h):
-    """Fr = v^2 / (g h)."""
+    """Fr = v^2 / (g h).
+
+    Parameters
+    ----------
+    v : float or ndarray
+        Speed (m/s).
+    h : float or ndarray
+        Hip height, i.e. leg length (m), > 0.
+
+    Returns
+    -------
+    float or ndarray
+        The Froude number (dimensionless); 1 at ``v = sqrt(g h)``, the walk / run boundary.
+
+    Examples
+    --------
+    >>> import math
+    >>> from footfall.planner import GRAVITY, froude_law
+    >>> round(froude_law(math.sqrt(GRAVITY * 0.12), 0.12), 9)
+    1.0
+    >>> round(froude_law(0.3, 0.12), 4)   # a spider at 0.3 m/s: 0.09 / (9.81 * 0.12)
+    0.0765
+    """
     return v * v / (GRAVITY * h)
 
 
 @register_jitable
 def stride_law(coefficient, exponent, v, h):
-    """lambda = coefficient * h * Fr^exponent (m), for v > 0 (at v = 0 there is no stride)."""
+    """lambda = coefficient * h * Fr^exponent (m), for v > 0 (at v = 0 there is no stride).
+
+    The law alone: :func:`stride_length` adds the case ``v = 0`` and the checks.
+
+    Parameters
+    ----------
+    coefficient : float
+        lambda / h at Fr = 1 (``GaitTiming.stride_coefficient``), > 0.
+    exponent : float
+        Exponent of the Froude number (``GaitTiming.stride_exponent``).
+    v : float or ndarray
+        Speed (m/s), > 0.
+    h : float or ndarray
+        Hip height (m), > 0.
+
+    Returns
+    -------
+    float or ndarray
+        Stride length (m).
+
+    Examples
+    --------
+    >>> import math
+    >>> from footfall.planner import GRAVITY, stride_law
+    >>> round(stride_law(2.3, 0.3, math.sqrt(GRAVITY * 0.12), 0.12), 6)   # Fr = 1: 2.3 * 0.12
+    0.276
+    """
     return coefficient * h * froude_law(v, h) ** exponent
 
 
 @register_jitable
 def duty_law(at_rest, slope, v, root_gh):
-    """The duty factor before its clip: at_rest - slope * v / sqrt(g h), ``root_gh`` = sqrt(g h)."""
+    """The duty factor before its clip: at_rest - slope * v / sqrt(g h), ``root_gh`` = sqrt(g h).
+
+    The law alone: :func:`duty_factor` adds the clip to ``[duty_min, duty_max]`` and the checks.
+
+    Parameters
+    ----------
+    at_rest : float
+        Duty factor extrapolated to ``v = 0`` (``GaitTiming.duty_at_rest``).
+    slope : float
+        Fall of the duty factor per unit of ``v / sqrt(g h)`` (``GaitTiming.duty_slope``).
+    v : float or ndarray
+        Speed (m/s).
+    root_gh : float or ndarray
+        sqrt(g h) (m/s), h the hip height.
+
+    Returns
+    -------
+    float or ndarray
+        The unclipped duty factor (dimensionless).
+
+    Examples
+    --------
+    >>> from footfall.planner import duty_law
+    >>> round(duty_law(0.72, 0.22, 1.0, 1.0), 6)   # v = sqrt(g h), i.e. Fr = 1
+    0.5
+    >>> round(duty_law(0.72, 0.22, 2.0, 1.0), 6)   # Fr = 4: below any sensible duty_min, to be clipped
+    0.28
+    """
     return at_rest - slope * v / root_gh
 SWING_MIN = 0.05
 """Least swing fraction of a speed-scaled disk."""
@@ -87,7 +162,43 @@ def _p(doc: str, default: float, *, unit: str = "-"):
 
 @dataclass(frozen=True)
 class GaitTiming(FlatParameters):
-    """Stride length, stride frequency and duty factor as functions of speed (module doc)."""
+    """Stride length, stride frequency and duty factor as functions of speed (module doc).
+
+    Every value is stored as a float; a non-number, a non-finite value or one outside its
+    range raises ValueError naming the field. :meth:`to_array` / :meth:`from_array` give the
+    flat float64 vector the tuning fits and the numba kernels read.
+
+    Attributes
+    ----------
+    stride_coefficient : float
+        lambda / h at Fr = 1 in ``lambda = stride_coefficient * h * Fr^stride_exponent``, > 0
+        (default 2.3).
+    stride_exponent : float
+        Exponent of the Froude number in the stride length, in [0, 0.5) (default 0.3).
+    min_frequency_hz : float
+        Least stride frequency (Hz) for ``v > 0``, > 0 (default 0.5).
+    duty_at_rest : float
+        Duty factor extrapolated to ``v = 0``, in (0, 1) (default 0.72).
+    duty_slope : float
+        Fall of the duty factor per unit of ``v / sqrt(g h)``, >= 0 (default 0.22).
+    duty_min, duty_max : float
+        Clip of the duty factor, ``0 < duty_min <= duty_max < 1`` (defaults 0.5, 0.85).
+
+    Examples
+    --------
+    >>> from footfall.planner import GaitTiming, duty_factor
+    >>> timing = GaitTiming(duty_min=0.6)
+    >>> timing.to_array().tolist()
+    [2.3, 0.3, 0.5, 0.72, 0.22, 0.6, 0.85]
+    >>> GaitTiming.from_array(timing.to_array()) == timing
+    True
+    >>> duty_factor(timing, 5.0, 0.12)   # fast: clipped at duty_min
+    0.6
+    >>> GaitTiming(stride_exponent=0.5)
+    Traceback (most recent call last):
+        ...
+    ValueError: GaitTiming.stride_exponent: must be in [0, 0.5), got 0.5
+    """
 
     stride_coefficient: float = _p("lambda / h at Fr = 1: lambda = stride_coefficient * h * Fr^stride_exponent (> 0)", 2.3)
     stride_exponent: float = _p("exponent of the Froude number in the stride length, in [0, 0.5) so that f rises with v", 0.3)
@@ -154,7 +265,37 @@ def froude_number(v, h):
 
 
 def stride_length(timing: GaitTiming, v, h):
-    """lambda = stride_coefficient * h * Fr^stride_exponent (m); 0 at v = 0. Broadcasts ``v`` and ``h``."""
+    """lambda = stride_coefficient * h * Fr^stride_exponent (m); 0 at v = 0. Broadcasts ``v`` and ``h``.
+
+    Parameters
+    ----------
+    timing : GaitTiming
+        The timing model.
+    v : float or array_like
+        Speed (m/s), finite and >= 0.
+    h : float or array_like
+        Hip height (m), finite and > 0 (e.g. :func:`hip_height`).
+
+    Returns
+    -------
+    float or ndarray
+        Stride length (m): a float when ``v`` and ``h`` are scalars, else their broadcast shape.
+
+    Raises
+    ------
+    ValueError
+        A speed < 0 or a height <= 0, or a value not finite.
+
+    Examples
+    --------
+    >>> import math
+    >>> from footfall.planner import GRAVITY, GaitTiming, stride_length
+    >>> timing = GaitTiming()
+    >>> round(stride_length(timing, math.sqrt(GRAVITY * 0.12), 0.12), 6)   # Fr = 1: 2.3 * 0.12
+    0.276
+    >>> stride_length(timing, [0.0, 0.3], 0.12).round(4).tolist()          # standing still: no stride
+    [0.0, 0.1276]
+    """
     speed, height, scalar = _speed_height(v, h)
     return _out(_stride_length(timing, speed, height), scalar)
 
@@ -162,7 +303,38 @@ def stride_length(timing: GaitTiming, v, h):
 def stride_frequency(timing: GaitTiming, v, h):
     """f = max(v / lambda, min_frequency_hz) where lambda > 0, else 0 (Hz): 0 at v = 0, and at the
     speeds so small that Fr^stride_exponent underflows to 0 (a body braking geometrically reached
-    2e-177 m/s; v / 0 stopped the run). Broadcasts ``v`` and ``h``."""
+    2e-177 m/s; v / 0 stopped the run). Broadcasts ``v`` and ``h``.
+
+    Parameters
+    ----------
+    timing : GaitTiming
+        The timing model.
+    v : float or array_like
+        Speed (m/s), finite and >= 0.
+    h : float or array_like
+        Hip height (m), finite and > 0.
+
+    Returns
+    -------
+    float or ndarray
+        Stride frequency (Hz): a float when ``v`` and ``h`` are scalars, else their broadcast shape.
+
+    Raises
+    ------
+    ValueError
+        A speed < 0 or a height <= 0, or a value not finite.
+
+    Examples
+    --------
+    >>> import math
+    >>> from footfall.planner import GRAVITY, GaitTiming, stride_frequency
+    >>> timing = GaitTiming()
+    >>> stride_frequency(timing, 0.0, 0.12), stride_frequency(timing, 0.001, 0.12)   # stopped; crawling
+    (0.0, 0.5)
+    >>> v = math.sqrt(GRAVITY * 0.12)                                                 # Fr = 1
+    >>> round(stride_frequency(timing, v, 0.12), 4), round(v / (2.3 * 0.12), 4)
+    (3.9311, 3.9311)
+    """
     speed, height, scalar = _speed_height(v, h)
     return _out(_stride_frequency(timing, speed, height), scalar)
 
@@ -185,7 +357,37 @@ def _stride_frequency(timing: GaitTiming, speed: np.ndarray, height) -> np.ndarr
 
 
 def duty_factor(timing: GaitTiming, v, h):
-    """DF = clip(duty_at_rest - duty_slope * v / sqrt(g h), duty_min, duty_max). Broadcasts ``v`` and ``h``."""
+    """DF = clip(duty_at_rest - duty_slope * v / sqrt(g h), duty_min, duty_max). Broadcasts ``v`` and ``h``.
+
+    Parameters
+    ----------
+    timing : GaitTiming
+        The timing model.
+    v : float or array_like
+        Speed (m/s), finite and >= 0.
+    h : float or array_like
+        Hip height (m), finite and > 0.
+
+    Returns
+    -------
+    float or ndarray
+        Duty factor, the fraction of a stride a foot stands: a float when ``v`` and ``h`` are
+        scalars, else their broadcast shape.
+
+    Raises
+    ------
+    ValueError
+        A speed < 0 or a height <= 0, or a value not finite.
+
+    Examples
+    --------
+    >>> from footfall.planner import GaitTiming, duty_factor
+    >>> timing = GaitTiming()
+    >>> round(duty_factor(timing, 0.3, 0.12), 2)   # a spider at 0.3 m/s: 0.72 - 0.22 * 0.3 / 1.085
+    0.66
+    >>> duty_factor(timing, [0.0, 5.0], 0.12).tolist()   # at rest; fast, clipped at duty_min
+    [0.72, 0.5]
+    """
     speed, height, scalar = _speed_height(v, h)
     raw = duty_law(timing.duty_at_rest, timing.duty_slope, speed, np.sqrt(GRAVITY * height))
     return _out(np.clip(raw, timing.duty_min, timing.duty_max), scalar)
@@ -211,5 +413,25 @@ def scaled_swing_durations(swing_duration, duty) -> np.ndarray:
 
 
 def hip_height(creature) -> float:
-    """h of a ``scenarios.Creature``: mean hip height above flat ground (m) when standing."""
+    """h of a ``scenarios.Creature``: mean hip height above flat ground (m) when standing.
+
+    Parameters
+    ----------
+    creature : Creature
+        A :class:`footfall.scenarios.Creature`.
+
+    Returns
+    -------
+    float
+        ``standing_height`` plus the mean height of the hips in the body frame (m).
+
+    Examples
+    --------
+    >>> from footfall.planner import hip_height
+    >>> from footfall.scenarios import load_creature
+    >>> hip_height(load_creature("spider"))      # hips at the pelvis' height, 0.12 m
+    0.12
+    >>> round(hip_height(load_creature("quadruped")), 3)
+    0.42
+    """
     return float(creature.standing_height + np.mean(np.asarray(creature.hips)[:, 1]))

@@ -46,7 +46,50 @@ def _w(doc: str, default: float, *, unit: str = "-", scale: bool = False):
 
 @dataclass(frozen=True)
 class ScoringWeights(FlatParameters):
-    """Weights (dimensionless, >= 0) and reference scales (> 0, units per field)."""
+    """Weights (dimensionless, >= 0) and reference scales (> 0, units per field).
+
+    Each term's goodness law is in its field's metadata (:meth:`describe` lists them in array
+    order); the module docstring is the tuning guide. Every value is stored as a float; a
+    non-number, a non-finite value, a negative weight, a reference scale <= 0 or five footprint
+    weights that are all 0 raise ValueError naming the field.
+
+    Attributes
+    ----------
+    footprint_distance, footprint_elevation, footprint_slope : float
+        Weights of closeness to the preferred footprint, flatness with the neighbour cells and
+        low slope (defaults 3, 1, 1).
+    footprint_leg_spacing, footprint_obstacle_proximity : float
+        Weights of room to the other legs and distance to forbidden cells (defaults 1, 1).
+    trajectory_length, trajectory_curvature, trajectory_clearance : float
+        Weights of a direct path, a straight path and a horizontal margin to blocked cells
+        (defaults 2, 1, 0.5).
+    trajectory_climb, trajectory_jerk : float
+        Weights of little rise beyond the step height and smooth 3D motion (defaults 1, 0.5).
+    distance_scale_m, step_critical_m, slope_critical_rad : float
+        Distance (m), height step (m) and slope (rad) at which a foothold is worth 0
+        (defaults 0.30, 0.12, 1.0).
+    leg_spacing_ref_m, proximity_ref_m, clearance_ref_m : float
+        Gap to the other legs, distance to a forbidden cell and path margin (m) that count as
+        enough (defaults 0.05, 0.10, 0.07).
+    curvature_energy_ref, climb_ref_m, jerk_ref : float
+        Curvature energy (-), extra rise (m) and normalised jerk (-) worth 1/2
+        (defaults 1.0, 0.10, 2000).
+
+    Examples
+    --------
+    >>> from footfall.planner import ScoringWeights
+    >>> w = ScoringWeights(footprint_distance=5)
+    >>> w.footprint_distance, w.jerk_ref
+    (5.0, 2000.0)
+    >>> w.to_array().shape                       # 10 weights and 9 reference scales
+    (19,)
+    >>> ScoringWeights.from_array(w.to_array()) == w
+    True
+    >>> ScoringWeights(jerk_ref=0.0)
+    Traceback (most recent call last):
+        ...
+    ValueError: ScoringWeights.jerk_ref: a reference scale must be > 0, got 0.0
+    """
 
     # -- footprint terms (paper §5.1) -------------------------------------------------
     footprint_distance: float = _w("closeness to the preferred footprint: s = max(0, 1 - d / distance_scale_m)", 3.0)
@@ -128,18 +171,89 @@ assert WEIGHT_FIELDS[:N_TERMS] == FOOTPRINT_WEIGHT_FIELDS + TRAJECTORY_WEIGHT_FI
 
 @register_jitable
 def falling_goodness(value, critical):
-    """1 - value / critical: distance, roughness and slope (floored at 0 by the caller)."""
+    """1 - value / critical: distance, roughness and slope (floored at 0 by the caller).
+
+    Parameters
+    ----------
+    value : float or ndarray
+        The raw number: distance to the preferred footprint (m), largest height step to a
+        neighbour cell (m) or slope (rad).
+    critical : float or ndarray
+        The value at which the goodness reaches 0 (``distance_scale_m``, ``step_critical_m``
+        or ``slope_critical_rad``), > 0.
+
+    Returns
+    -------
+    float or ndarray
+        ``1 - value / critical``: 1 at ``value = 0``, 0 at ``critical``, negative beyond it.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from footfall.planner import falling_goodness
+    >>> falling_goodness(np.array([0.0, 0.15, 0.3]), 0.3).tolist()
+    [1.0, 0.5, 0.0]
+    >>> falling_goodness(0.45, 0.3)   # beyond the critical value: the caller floors it at 0
+    -0.5
+    """
     return 1.0 - value / critical
 
 
 @register_jitable
 def rising_goodness(value, reference):
     """value / reference: leg spacing, obstacle proximity, clearance (capped at 1 by the caller), and
-    directness (the straight distance over the path length, at least the distance)."""
+    directness (the straight distance over the path length, at least the distance).
+
+    Parameters
+    ----------
+    value : float or ndarray
+        The raw number: gap to the other legs, distance to a forbidden cell or horizontal path
+        margin (m); for directness, the straight source-to-footprint distance (m).
+    reference : float or ndarray
+        The value worth 1 (``leg_spacing_ref_m``, ``proximity_ref_m``, ``clearance_ref_m``);
+        for directness, the path length, at least the straight distance. > 0.
+
+    Returns
+    -------
+    float or ndarray
+        ``value / reference``: 0 at ``value = 0``, 1 at the reference, above 1 beyond it.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from footfall.planner import rising_goodness
+    >>> rising_goodness(np.array([0.05, 0.2]), 0.1).tolist()   # the caller caps 2.0 at 1
+    [0.5, 2.0]
+    >>> rising_goodness(0.3, 0.6)   # directness: a 0.3 m step along a 0.6 m path
+    0.5
+    """
     return value / reference
 
 
 @register_jitable
 def rational_goodness(value, reference):
-    """1 / (1 + value / reference): curvature, climb and jerk (1/2 at the reference)."""
+    """1 / (1 + value / reference): curvature, climb and jerk (1/2 at the reference).
+
+    Parameters
+    ----------
+    value : float or ndarray
+        The raw number, >= 0: curvature energy (-), climb beyond the step height (m) or
+        normalised jerk (-).
+    reference : float or ndarray
+        The value worth 1/2 (``curvature_energy_ref``, ``climb_ref_m`` or ``jerk_ref``), > 0.
+
+    Returns
+    -------
+    float or ndarray
+        ``1 / (1 + value / reference)``, in (0, 1] for ``value >= 0``: 1 at 0, 1/2 at the
+        reference, falling towards 0 without reaching it.
+
+    Examples
+    --------
+    >>> from footfall.planner import rational_goodness
+    >>> rational_goodness(0.0, 0.1), rational_goodness(0.1, 0.1)
+    (1.0, 0.5)
+    >>> round(rational_goodness(0.3, 0.1), 6)   # three times the reference: 1 / 4
+    0.25
+    """
     return 1.0 / (1.0 + value / reference)

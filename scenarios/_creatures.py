@@ -22,33 +22,61 @@ class Creature:
 
     Attributes
     ----------
-    name:
+    name : str
         Creature name.
-    leg_names:
+    leg_names : tuple of str
         (L,) unique leg names, e.g. ``("L1", ..., "R4")``.
-    hips:
-        (L, 3) hip joint positions, body frame, m.
-    segment_lengths:
-        (L, S) m, hip to foot, S >= 2, all > 0.
-    joint_limits:
-        (L, S, 2) radians, (min, max) of joint ``j`` at the proximal end of
+    hips : (L, 3) ndarray
+        Hip joint positions, body frame, m.
+    segment_lengths : (L, S) ndarray
+        m, hip to foot, S >= 2, all > 0.
+    joint_limits : (L, S, 2) ndarray
+        Radians, (min, max) of joint ``j`` at the proximal end of
         segment ``j``; min < max. Convention (see ``scenarios/README.md``):
         hinges in the leg's vertical plane; joint 0 is the pitch of segment 0
         below the horizontal, joint j > 0 the bend of segment j relative to
         segment j - 1, positive = downward.
-    rest_feet:
-        (L, 2) default feet spacing: body-frame (forward, lateral) of each
+    rest_feet : (L, 2) ndarray
+        Default feet spacing: body-frame (forward, lateral) of each
         foot at rest, on flat ground ``standing_height`` below the pelvis.
-    foot_length, foot_width:
+    foot_length, foot_width : float
         Projected foot rectangle (m); its length runs along the leg's outward
         direction (hip to rest foot, see :attr:`foot_directions`).
-    body_thickness:
+    body_thickness : float
         Pelvis height above the support hull (m), <= ``standing_height``.
-    body_box:
-        (2,) projected body bounding box (length along forward, width along
+    body_box : (2,) ndarray
+        Projected body bounding box (length along forward, width along
         lateral), m, centred on the pelvis.
-    standing_height:
+    standing_height : float
         Nominal pelvis height above flat ground (m).
+
+    Construction checks the creature file's rules (``scenarios/README.md``, "Checks") and raises
+    :class:`footfall.InputError` naming the field, e.g. ``rest_feet[2]``.
+
+    Examples
+    --------
+    A built-in creature (:func:`load_creature`):
+
+    >>> from footfall.scenarios import Creature, load_creature
+    >>> ant = load_creature("ant")
+    >>> ant.n_legs, ant.n_segments, ant.leg_names
+    (6, 3, ('L1', 'L2', 'L3', 'R1', 'R2', 'R3'))
+    >>> ant.hips.shape, ant.joint_limits.shape
+    ((6, 3), (6, 3, 2))
+    >>> ant.hips.flags.writeable
+    False
+
+    One leg of two 0.1 m segments, its foot straight below the hip:
+
+    >>> stilt = Creature(name="stilt", leg_names=("A",), hips=[[0.0, 0.0, 0.0]], segment_lengths=[[0.1, 0.1]],
+    ...                  joint_limits=[[[-1.0, 1.0], [0.0, 2.0]]], rest_feet=[[0.0, 0.0]], foot_length=0.03,
+    ...                  foot_width=0.02, body_thickness=0.05, body_box=[0.2, 0.1], standing_height=0.15)
+    >>> stilt.leg_reach, stilt.max_reach
+    (array([0.2]), 0.2)
+    >>> stilt.foot_directions    # a foot below its hip points forward
+    array([[1., 0.]])
+    >>> round(stilt.rest_radius, 3)    # half the body box's diagonal, 0.5 * hypot(0.2, 0.1)
+    0.112
     """
 
     name: str
@@ -139,7 +167,14 @@ class Creature:
 
     @property
     def leg_reach(self) -> np.ndarray:
-        """(L,) m: each leg's fully stretched length (sum of its segments)."""
+        """(L,) m: each leg's fully stretched length (sum of its segments).
+
+        Examples
+        --------
+        >>> from footfall.scenarios import load_creature
+        >>> load_creature("quadruped").leg_reach    # 0.23 + 0.21 + 0.12 m per leg
+        array([0.56, 0.56, 0.56, 0.56])
+        """
         return readonly(self.segment_lengths.sum(axis=1))
 
     @property
@@ -153,6 +188,13 @@ class Creature:
 
         This is the direction along which :attr:`foot_length` runs. A rest foot
         straight below its hip gets (1, 0) (forward).
+
+        Examples
+        --------
+        >>> from footfall.scenarios import load_creature
+        >>> load_creature("ant").foot_directions[[1, 4]]    # the middle legs point straight left and right
+        array([[ 0.,  1.],
+               [ 0., -1.]])
         """
         offsets = self.rest_feet - self.hips[:, [0, 2]]
         norms = np.linalg.norm(offsets, axis=1, keepdims=True)

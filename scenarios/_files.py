@@ -46,12 +46,36 @@ _DEFAULT_FOV = 0.9  # radians
 
 
 def builtin_scenario_names() -> tuple[str, ...]:
-    """Names of the built-in scenarios, sorted."""
+    """Names of the built-in scenarios, sorted.
+
+    Returns
+    -------
+    tuple of str
+        The stems of ``scenarios/data/*.toml``; each is a name for :func:`load_scenario`.
+
+    Examples
+    --------
+    >>> from footfall.scenarios import builtin_scenario_names
+    >>> builtin_scenario_names()
+    ('crates', 'crates-moving', 'flat', 'hills', 'mixed', 'stairs')
+    """
     return tuple(sorted(path.stem for path in DATA_DIR.glob("*.toml")))
 
 
 def builtin_creature_names() -> tuple[str, ...]:
-    """Names of the built-in creatures, sorted."""
+    """Names of the built-in creatures, sorted.
+
+    Returns
+    -------
+    tuple of str
+        The stems of ``scenarios/data/creatures/*.toml``; each is a name for :func:`load_creature`.
+
+    Examples
+    --------
+    >>> from footfall.scenarios import builtin_creature_names
+    >>> builtin_creature_names()
+    ('ant', 'quadruped', 'robot5', 'spider')
+    """
     return tuple(sorted(path.stem for path in CREATURES_DIR.glob("*.toml")))
 
 
@@ -173,13 +197,106 @@ def load_creature(name_or_path: str | Path) -> Creature:
     This is the one resolver of a creature reference: every command that takes a creature
     (``--creature``, ``[crowd] creature``) goes through it, so a file works wherever a name does.
     Raises :class:`InputError` naming the file and field on any problem.
+
+    Parameters
+    ----------
+    name_or_path : str or pathlib.Path
+        A built-in creature name, or the path of a creature file (format: ``scenarios/README.md``).
+        A string is looked up among the built-ins first; a ``Path`` is always a file.
+
+    Returns
+    -------
+    Creature
+        Named after the file's ``name``, else the file name without ``.toml``.
+
+    Raises
+    ------
+    footfall.InputError
+        One line ``FILE: FIELD: REASON``; FILE is the path as given, or ``builtin:NAME``.
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> import footfall.scenarios
+    >>> from footfall import InputError
+    >>> from footfall.scenarios import load_creature
+    >>> spider = load_creature("spider")
+    >>> spider.n_legs, spider.n_segments, round(spider.standing_height, 2)
+    (8, 4, 0.12)
+
+    A file (here the example creature shipped next to the package's data):
+
+    >>> heptapod = load_creature(Path(footfall.scenarios.__file__).parent / "examples" / "heptapod.toml")
+    >>> heptapod.name, heptapod.n_legs
+    ('heptapod', 7)
+
+    A name that is neither a built-in nor a file:
+
+    >>> try:
+    ...     load_creature("centipede")
+    ... except InputError as error:
+    ...     print(error)
+    centipede: creature: unknown creature; built-ins are: ant, quadruped, robot5, spider
     """
     path, file = _resolve(name_or_path, CREATURES_DIR, builtin_creature_names(), "creature")
     return _creature_from_text(_read_text(path, file, "creature"), path.stem, file)
 
 
 def load_creature_text(text: str, label: str) -> Creature:
-    """A creature from the text of a creature file (a recording's ``creature_toml``); errors name ``label``."""
+    """A creature from the text of a creature file (a recording's ``creature_toml``); errors name ``label``.
+
+    Parameters
+    ----------
+    text : str
+        TOML text in the creature file format (``scenarios/README.md``).
+    label : str
+        The file name that errors name; without a ``name`` key the creature is named after it
+        (without its folder and ``.toml``).
+
+    Returns
+    -------
+    Creature
+
+    Raises
+    ------
+    footfall.InputError
+        One line ``LABEL: FIELD: REASON`` on any problem.
+
+    Examples
+    --------
+    A one-legged creature: its foot rests 0.14 m from the hip, within 0.98 x its 0.2 m reach.
+
+    >>> from footfall import InputError
+    >>> from footfall.scenarios import load_creature_text
+    >>> text = '''
+    ... standing_height = 0.1
+    ... body_thickness = 0.05
+    ... body_box = [0.2, 0.1]
+    ... foot = { length = 0.03, width = 0.02 }
+    ... [[legs]]
+    ... name = "A"
+    ... hip = [0.0, 0.0, 0.05]
+    ... rest_foot = [0.0, 0.15]
+    ... segments = [0.1, 0.1]
+    ... joint_limits = [[-1.0, 1.0], [0.0, 2.0]]
+    ... '''
+    >>> tiny = load_creature_text(text, "tiny.toml")
+    >>> tiny.name, tiny.leg_names, tiny.leg_reach
+    ('tiny', ('A',), array([0.2]))
+
+    Bad input names the file and the field, as written in the file:
+
+    >>> try:
+    ...     load_creature_text(text.replace("rest_foot = [0.0, 0.15]", "rest_foot = [0.0, 0.5]"), "tiny.toml")
+    ... except InputError as error:
+    ...     print(error)  # doctest: +ELLIPSIS
+    tiny.toml: legs[0].rest_foot: rest foot out of reach: 0.461 m from the hip, leg reach 0.200 m ...
+    >>> try:
+    ...     load_creature_text(text.replace("[0.2, 0.1]", "[0.2, -0.1]"), "tiny.toml")
+    ... except InputError as error:
+    ...     print(error)
+    tiny.toml: body_box[1]: must be > 0
+    """
     return _creature_from_text(text, Path(label).stem, label)
 
 
@@ -261,6 +378,31 @@ def split_variant(spec: str) -> tuple[str, dict[str, Any]]:
     (the same kind of terrain from another seed), ``flat@crowd.speed=0.12``, ``stairs@crowd.centre=[-3.0,0.0]``
     (commas inside brackets belong to the value). It is a plain string, so a task sent to another
     machine carries it and loads the same scenario there.
+
+    Parameters
+    ----------
+    spec : str
+        ``NAME`` or ``NAME@key=value,...``; keys are the scenario file's dotted keys.
+
+    Returns
+    -------
+    name : str
+        The part before ``@`` (a built-in name or a path).
+    overrides : dict
+        Dotted key -> value (int, float, str, bool, list, ...), in the order given; empty without ``@``.
+
+    Raises
+    ------
+    footfall.InputError
+        On an item that is not ``key=value`` or a value that is not TOML (file ``spec``, field ``scenario``).
+
+    Examples
+    --------
+    >>> from footfall.scenarios import split_variant
+    >>> split_variant("hills@seed=3,crowd.centre=[-3.0, 0.0]")
+    ('hills', {'seed': 3, 'crowd.centre': [-3.0, 0.0]})
+    >>> split_variant("flat")
+    ('flat', {})
     """
     name, _, rest = spec.partition("@")
     overrides: dict[str, Any] = {}
@@ -296,7 +438,32 @@ def _split_top_level(text: str) -> list[str]:
 
 def variant_name(name: str, **overrides: Any) -> str:
     """The variant string of ``name`` with ``overrides`` (dotted keys as keyword names with ``__``
-    for dots: ``variant_name("hills", seed=3, crowd__speed=0.1)``); floats written exactly."""
+    for dots: ``variant_name("hills", seed=3, crowd__speed=0.1)``); floats written exactly.
+
+    The inverse of :func:`split_variant`.
+
+    Parameters
+    ----------
+    name : str
+        A built-in scenario name or a path.
+    **overrides
+        Values to replace, by dotted key with ``__`` for each dot.
+
+    Returns
+    -------
+    str
+        ``name`` alone without overrides, else ``name@key=value,...``.
+
+    Examples
+    --------
+    >>> from footfall.scenarios import split_variant, variant_name
+    >>> variant_name("hills", seed=3, crowd__speed=0.1)
+    'hills@seed=3,crowd.speed=0.1'
+    >>> variant_name("flat")
+    'flat'
+    >>> split_variant(variant_name("stairs", crowd__centre=[-3.0, 0.0]))
+    ('stairs', {'crowd.centre': [-3.0, 0.0]})
+    """
     items = [f"{k.replace('__', '.')}={v!r}" for k, v in overrides.items()]
     return name + ("@" + ",".join(items) if items else "")
 
@@ -319,6 +486,79 @@ def load_scenario(name_or_path: str | Path) -> Scenario:
 
     Paths inside the file (height maps, creature files) are relative to the
     file. Raises :class:`InputError` naming the file and field on any problem.
+
+    Parameters
+    ----------
+    name_or_path : str or pathlib.Path
+        A built-in scenario name, the path of a scenario file (format: ``scenarios/README.md``), or
+        either followed by ``@key=value,...``. A string is looked up among the built-ins first; a
+        ``Path`` is always a file.
+
+    Returns
+    -------
+    Scenario
+        Its ``source`` is the path as given or ``builtin:NAME``, followed by the variant's overrides.
+
+    Raises
+    ------
+    footfall.InputError
+        One line ``FILE: FIELD: REASON``, the field as written in the file (``obstacles[2].size[1]``).
+
+    Examples
+    --------
+    >>> from footfall import InputError
+    >>> from footfall.scenarios import load_scenario
+    >>> hills = load_scenario("hills")
+    >>> hills.source, hills.terrain.heights.shape
+    ('builtin:hills', (401, 401))
+
+    A variant: the same file with other values.
+
+    >>> faster = load_scenario("flat@crowd.speed=0.12,seed=2")
+    >>> faster.source, faster.crowd.speed, faster.seed
+    ('builtin:flat@crowd.speed=0.12,seed=2', 0.12, 2)
+    >>> try:
+    ...     load_scenario("flat@crowd.goal=[50.0, 0.0]")
+    ... except InputError as error:
+    ...     print(error)
+    builtin:flat@crowd.goal=[50.0, 0.0]: crowd.goal: outside the terrain (x in [-10, 10], z in [-10, 10])
+
+    A file: 4 m x 4 m of flat ground, one box, one ant. The box rests on the ground (centre
+    y = half its 0.3 m height); the camera, not given, looks at the crowd from 4 m behind and 3 m up.
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> folder = tempfile.TemporaryDirectory()
+    >>> path = Path(folder.name) / "my.toml"
+    >>> _ = path.write_text('''
+    ... [terrain]
+    ... kind = "flat"
+    ... size = [4.0, 4.0]
+    ... cell_size = 0.1
+    ...
+    ... [[obstacles]]
+    ... centre = [1.0, 1.0]
+    ... size = [0.4, 0.3, 0.5]
+    ...
+    ... [crowd]
+    ... creature = "ant"
+    ... goal = [1.5, 0.0]
+    ... ''')
+    >>> scenario = load_scenario(path)
+    >>> scenario.name, scenario.crowd.creature, scenario.obstacles.centres.tolist()
+    ('my', 'ant', [[1.0, 0.15, 1.0]])
+    >>> scenario.camera.position.tolist()
+    [-4.0, 3.0, 0.0]
+
+    Bad input names the file and the field:
+
+    >>> _ = path.write_text(path.read_text().replace("[0.4, 0.3, 0.5]", "[0.4, -0.3, 0.5]"))
+    >>> try:
+    ...     load_scenario(path)
+    ... except InputError as error:
+    ...     print("InputError:", error)  # doctest: +ELLIPSIS
+    InputError: ...my.toml: obstacles[0].size[1]: must be > 0
+    >>> folder.cleanup()
     """
     overrides: dict[str, Any] = {}
     if isinstance(name_or_path, str) and "@" in name_or_path and not _is_file(Path(name_or_path)):

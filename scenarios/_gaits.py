@@ -89,7 +89,23 @@ _RING_SEARCH_MAX = 7
 
 
 def required_stance_feet(n_legs: int) -> int:
-    """Least number of feet that must be in stance at every phase: 2 if ``n_legs`` >= 3, else 1."""
+    """Least number of feet that must be in stance at every phase: 2 if ``n_legs`` >= 3, else 1.
+
+    Parameters
+    ----------
+    n_legs : int
+        Number of legs L of the creature.
+
+    Returns
+    -------
+    int
+
+    Examples
+    --------
+    >>> from footfall.scenarios import required_stance_feet
+    >>> required_stance_feet(6), required_stance_feet(2), required_stance_feet(1)
+    (2, 1, 1)
+    """
     return 2 if n_legs >= 3 else 1
 
 
@@ -115,7 +131,39 @@ def stance_profile(swing_start, swing_duration) -> tuple[np.ndarray, np.ndarray,
 
 
 def min_stance_feet(swing_start, swing_duration) -> tuple[int, float]:
-    """(least number of feet in stance over the cycle, a phase where that happens)."""
+    """(least number of feet in stance over the cycle, a phase where that happens).
+
+    Exact, as the module doc describes: the count is evaluated once on every piece of the
+    cycle between the sectors' starts and finishes.
+
+    Parameters
+    ----------
+    swing_start : array_like
+        (L,) phase in [0, 1) at which each foot's swing begins.
+    swing_duration : array_like
+        (L,) swing fraction of the cycle of each foot, in (0, 1).
+
+    Returns
+    -------
+    least : int
+        Least number of feet in stance at any phase.
+    phase : float
+        The middle of the first piece of the cycle (in [0, 1)) with that few feet in stance.
+
+    Examples
+    --------
+    A trot: diagonal pairs swing for 0.45 of a cycle, half a cycle apart. Two feet are
+    down while a pair swings, from 0 to 0.45 (middle 0.225):
+
+    >>> from footfall.scenarios import min_stance_feet
+    >>> min_stance_feet([0.0, 0.5, 0.5, 0.0], [0.45, 0.45, 0.45, 0.45])
+    (2, 0.225)
+
+    Three legs, half a cycle each, a quarter apart: from 0.25 to 0.5 two of them swing.
+
+    >>> min_stance_feet([0.0, 0.25, 0.5], [0.5, 0.5, 0.5])
+    (1, 0.375)
+    """
     begin, end, stance = stance_profile(swing_start, swing_duration)
     k = int(np.argmin(stance))
     return int(stance[k]), float(np.mod(0.5 * (begin[k] + end[k]), 1.0))
@@ -149,19 +197,42 @@ class Gait:
 
     Attributes
     ----------
-    name:
+    name : str
         Gait name.
-    leg_names:
+    leg_names : tuple of str
         (L,) the legs, in the creature's order.
-    swing_start:
-        (L,) read-only float64, phase in [0, 1) at which each foot's swing begins.
-    swing_duration:
-        (L,) read-only float64, swing fraction of the cycle, in (0, 1).
-    description:
+    swing_start : (L,) ndarray
+        Read-only float64, phase in [0, 1) at which each foot's swing begins.
+    swing_duration : (L,) ndarray
+        Read-only float64, swing fraction of the cycle, in (0, 1).
+    description : str
         Free text.
 
     Construction checks ranges and the support rule (module doc) and raises
     :class:`InputError` naming ``swing_start[i]``, ``swing_duration[i]`` or ``swing``.
+
+    Examples
+    --------
+    Gaits are usually loaded (:func:`load_gait`); one can also be written out:
+
+    >>> from footfall import InputError
+    >>> from footfall.scenarios import Gait
+    >>> trot = Gait("trot", ("LF", "RF", "LH", "RH"), swing_start=[0.0, 0.5, 0.5, 0.0],
+    ...             swing_duration=[0.4, 0.4, 0.4, 0.4])
+    >>> trot.n_legs, round(trot.duty_factor, 2)
+    (4, 0.6)
+    >>> trot.swing_finish.tolist()
+    [0.4, 0.9, 0.9, 0.4]
+    >>> trot.phase_offsets("RF").tolist()    # relative to RF's swing start
+    [0.5, 0.0, 0.0, 0.5]
+
+    An impossible gait is refused:
+
+    >>> try:
+    ...     Gait("hop", ("A", "B", "C"), swing_start=[0.0, 0.0, 0.0], swing_duration=[0.5, 0.5, 0.5])
+    ... except InputError as error:
+    ...     print(error)
+    argument: swing: impossible gait: every foot swings at once around phase 0.25
     """
 
     name: str
@@ -231,7 +302,26 @@ class _GaitFile(schema._Model):
 
 
 def builtin_gait_names(creature: Creature | str | None = None) -> tuple[str, ...]:
-    """Names of the built-in gaits, sorted; with ``creature``, only those whose legs match it."""
+    """Names of the built-in gaits, sorted; with ``creature``, only those whose legs match it.
+
+    Parameters
+    ----------
+    creature : Creature or str, optional
+        A :class:`Creature`, or a name or file for :func:`load_creature`. None (default): every built-in gait.
+
+    Returns
+    -------
+    tuple of str
+        Names for :func:`load_gait` (the stems of ``scenarios/data/gaits/*.toml``).
+
+    Examples
+    --------
+    >>> from footfall.scenarios import builtin_gait_names
+    >>> len(builtin_gait_names())
+    8
+    >>> builtin_gait_names("quadruped")
+    ('quadruped-pace', 'quadruped-trot', 'quadruped-walk')
+    """
     names = tuple(sorted(path.stem for path in GAITS_DIR.glob("*.toml")))
     if creature is None:
         return names
@@ -254,6 +344,28 @@ def default_gait_name(creature_name: Creature | str) -> str:
     whose legs the built-in default does not fit gets :data:`DEFAULT_GAIT` (``"default"``):
     :func:`load_gait` then generates its gait (:func:`generate_gait`). Raises
     :class:`InputError` for the name of a creature that is neither.
+
+    Parameters
+    ----------
+    creature_name : Creature or str
+        A creature, or the name of a built-in creature or of one loaded from a file.
+
+    Returns
+    -------
+    str
+        A built-in gait name, or ``"default"``.
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> import footfall.scenarios
+    >>> from footfall.scenarios import default_gait_name, load_creature
+    >>> default_gait_name("spider")
+    'spider-metachronal-wave'
+    >>> default_gait_name(load_creature("ant"))
+    'ant-tripod'
+    >>> default_gait_name(load_creature(Path(footfall.scenarios.__file__).parent / "examples" / "heptapod.toml"))
+    'default'
     """
     if isinstance(creature_name, Creature):
         creature = creature_name
@@ -290,11 +402,25 @@ def default_gait(creature: Creature) -> Gait:
     Parameters
     ----------
     creature : Creature
+        Any creature; one with fewer than 3 legs and no fitting built-in gait is refused
+        (:func:`generate_gait`).
 
     Returns
     -------
     Gait
         In the creature's leg order; it keeps the support rule (:func:`check_support`).
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> import footfall.scenarios
+    >>> from footfall.scenarios import default_gait, load_creature
+    >>> default_gait(load_creature("ant")).name
+    'ant-tripod'
+    >>> heptapod = load_creature(Path(footfall.scenarios.__file__).parent / "examples" / "heptapod.toml")
+    >>> gait = default_gait(heptapod)
+    >>> gait.name, gait.n_legs, round(gait.duty_factor, 2)
+    ('heptapod-generated', 7, 0.72)
     """
     name = DEFAULT_GAITS.get(creature.name)
     if name is not None:
@@ -412,10 +538,33 @@ def generate_gait(creature: Creature) -> Gait:
     shortened (never below a twentieth of a cycle) until ring or side neighbours are never
     in the air together and the support rule holds (:func:`check_support`).
 
+    Parameters
+    ----------
+    creature : Creature
+        A creature with at least 3 legs.
+
+    Returns
+    -------
+    Gait
+        Named ``"NAME-generated"``, in the creature's leg order; its description says which
+        rule made it and its duty factor.
+
     Raises
     ------
     InputError
         On field ``gait`` for a creature with fewer than 3 legs.
+
+    Examples
+    --------
+    The quadruped's legs are LF, RF, LH, RH: each side's wave runs back to front a quarter
+    cycle apart (LH, then LF), the right side half a cycle after the left (the lateral-sequence walk):
+
+    >>> from footfall.scenarios import generate_gait, load_creature
+    >>> gait = generate_gait(load_creature("quadruped"))
+    >>> gait.name, gait.swing_start.tolist()
+    ('quadruped-generated', [0.25, 0.75, 0.0, 0.5])
+    >>> gait.swing_duration.tolist(), round(gait.duty_factor, 2)
+    ([0.25, 0.25, 0.25, 0.25], 0.75)
     """
     n = creature.n_legs
     if n < 3:
@@ -471,6 +620,39 @@ def load_gait(name_or_path: str | Path, creature: Creature | str | Path) -> Gait
     bad TOML, unknown key, NaN, start outside [0, 1), duration outside (0, 1),
     unknown or missing leg, a different number of legs than the creature, or
     an impossible gait (support rule, module doc).
+
+    Parameters
+    ----------
+    name_or_path : str or pathlib.Path
+        A built-in gait name, ``"default"`` (:func:`default_gait`), or the path of a gait file.
+        A string is looked up among the built-ins first; a ``Path`` is always a file.
+    creature : Creature, str or pathlib.Path
+        The creature the gait is for.
+
+    Returns
+    -------
+    Gait
+        Named after the file's ``name``, else the file name without ``.toml``.
+
+    Raises
+    ------
+    footfall.InputError
+        One line ``FILE: FIELD: REASON``; FILE is the path as given, or ``builtin:NAME``.
+
+    Examples
+    --------
+    >>> from footfall import InputError
+    >>> from footfall.scenarios import load_gait
+    >>> trot = load_gait("quadruped-trot", "quadruped")
+    >>> trot.leg_names, trot.swing_start.tolist(), round(trot.duty_factor, 2)
+    (('LF', 'RF', 'LH', 'RH'), [0.0, 0.5, 0.5, 0.0], 0.55)
+    >>> load_gait("default", "ant").name
+    'ant-tripod'
+    >>> try:
+    ...     load_gait("ant-tripod", "quadruped")
+    ... except InputError as error:
+    ...     print(error)  # doctest: +ELLIPSIS
+    builtin:ant-tripod: swing: the gait gives 6 legs (L1, R2, L3, R1, L2, R3) but creature 'quadruped' has 4 legs ...
     """
     creature = _as_creature(creature)
     if isinstance(name_or_path, str) and name_or_path == DEFAULT_GAIT:

@@ -44,6 +44,30 @@ def flat_heightfield(size: tuple[float, float], cell_size: float, height: float 
     """Flat ground at ``height`` m over ``size`` = (x, z) extent in m, centred on the origin.
 
     An extent that is not a whole number of cells is rounded up.
+
+    Parameters
+    ----------
+    size : (float, float)
+        Extent (m) along x and z, each > 0.
+    cell_size : float
+        Grid spacing (m), > 0.
+    height : float, optional
+        Ground height y (m); default 0.
+
+    Returns
+    -------
+    Heightfield
+
+    Examples
+    --------
+    >>> from footfall.scenarios import flat_heightfield
+    >>> ground = flat_heightfield((2.0, 1.0), 0.5, height=0.2)
+    >>> ground.heights.shape, ground.x_range, ground.z_range    # 3 rows along z, 5 columns along x
+    ((3, 5), (-1.0, 1.0), (-0.5, 0.5))
+    >>> float(ground.height_at(0.3, -0.1))
+    0.2
+    >>> flat_heightfield((1.2, 1.0), 0.5).x_range    # 1.2 m is 2.4 cells: 3 cells, 1.5 m
+    (-0.75, 0.75)
     """
     xs, zs = _grid(size, cell_size)
     heights = np.full((zs.size, xs.size), finite_float(height, "height"))
@@ -65,6 +89,40 @@ def hills_heightfield(
     with wavelengths near ``wavelength / 2**o`` m (+-25 %) and weight
     ``persistence**o``. The sum is then shifted and scaled so the lowest point
     is at 0 m and the highest at ``amplitude`` m.
+
+    Parameters
+    ----------
+    size : (float, float)
+        Extent (m) along x and z, each > 0, centred on the origin; rounded up to whole cells.
+    cell_size : float
+        Grid spacing (m), > 0.
+    amplitude : float
+        Height span (m), >= 0.
+    wavelength : float
+        Main wavelength (m), > 0.
+    octaves : int, optional
+        Number of octaves, >= 1; default 3.
+    persistence : float, optional
+        Weight of each further octave, > 0; default 0.5.
+    seed : int, optional
+        Seed of ``np.random.default_rng``; default 0.
+
+    Returns
+    -------
+    Heightfield
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from footfall.scenarios import hills_heightfield
+    >>> hills = hills_heightfield((4.0, 4.0), 0.1, amplitude=0.3, wavelength=2.0, seed=1)
+    >>> hills.heights.shape, hills.x_range
+    ((41, 41), (-2.0, 2.0))
+    >>> round(float(hills.heights.min()), 3), round(float(hills.heights.max()), 3)
+    (0.0, 0.3)
+    >>> again = hills_heightfield((4.0, 4.0), 0.1, amplitude=0.3, wavelength=2.0, seed=1)
+    >>> bool(np.array_equal(hills.heights, again.heights))    # the same seed gives the same hills
+    True
     """
     amplitude = finite_float(amplitude, "amplitude")
     if amplitude < 0.0:
@@ -111,6 +169,44 @@ def stairs_heightfield(
     ``start + (steps - 1) * run``. Without ``landing`` the top continues to the
     terrain edge; with it, the top is ``landing`` m deep and a mirror flight
     descends back to 0 m.
+
+    Parameters
+    ----------
+    size : (float, float)
+        Extent (m) along x and z, each > 0, centred on the origin; rounded up to whole cells.
+    cell_size : float
+        Grid spacing (m), > 0.
+    rise : float
+        Step height (m), > 0.
+    run : float
+        Step depth (m), > 0.
+    steps : int
+        Number of steps, >= 1.
+    start : float, optional
+        Distance ``d`` (m) of the first riser; default 0.
+    direction : float, optional
+        Climbing direction (radians) about +y; default 0 (+x).
+    landing : float, optional
+        Depth (m) of the top before a mirror flight descends; None (default): no descent.
+
+    Returns
+    -------
+    Heightfield
+
+    Examples
+    --------
+    Three 0.1 m steps, 0.5 m deep, climbing along +x from x = 0:
+
+    >>> from footfall.scenarios import stairs_heightfield
+    >>> stairs = stairs_heightfield((6.0, 1.0), 0.1, rise=0.1, run=0.5, steps=3)
+    >>> stairs.height_at([-1.0, 0.25, 0.75, 1.25, 2.9], 0.0).round(3)    # x in [-3, 3] m
+    array([0. , 0.1, 0.2, 0.3, 0.3])
+
+    With a 0.5 m landing (the top runs from x = 1 m to 1.5 m), then down again:
+
+    >>> stairs = stairs_heightfield((6.0, 1.0), 0.1, rise=0.1, run=0.5, steps=3, landing=0.5)
+    >>> stairs.height_at([1.25, 1.75, 2.25, 2.75], 0.0).round(3)
+    array([0.3, 0.2, 0.1, 0. ])
     """
     rise = positive_float(rise, "rise")
     run = positive_float(run, "run")
@@ -156,34 +252,43 @@ class CrateRecipe:
 
     Attributes
     ----------
-    count:
+    count : int
         Number of crates, >= 0.
-    region:
+    region : (float, float, float, float)
         (x_min, z_min, x_max, z_max): crates (and their loops) stay inside.
-    footprint_range:
+    footprint_range : (float, float), default (0.1, 0.6)
         Range of each horizontal box extent (local x and z, drawn independently).
-    height_range:
+    height_range : (float, float), default (0.1, 0.6)
         Range of box height (local y).
-    safe_height_range:
+    safe_height_range : (float, float) or None, default None
         Range of the height of safe crates (e.g. low enough to step on);
         ``None`` (default) uses ``height_range``.
-    forbidden_fraction:
+    forbidden_fraction : float, default 0.5
         Share of the *static* crates that are forbidden (rounded); the rest are
         safe to step on. Moving crates are always forbidden.
-    moving_fraction:
+    moving_fraction : float, default 0
         Share of all crates that move (rounded).
-    velocity_fraction:
+    velocity_fraction : float, default 0.5
         Share of the moving crates that move at constant velocity (rounded);
         the rest loop along waypoints. Constant-velocity crates move
         horizontally at their initial height and do not follow the terrain,
         so prefer 0 on uneven ground.
-    speed_range:
+    speed_range : (float, float), default (0.1, 0.4)
         Range of crate speeds.
-    loop_radius_range:
+    loop_radius_range : (float, float), default (0.5, 1.5)
         Range of the radius of a waypoint loop (3 to 6 points around a circle
         through the crate's start).
-    min_gap:
+    min_gap : float, default 0.1
         Minimum clearance between the bounding circles of crates at t = 0.
+
+    The recipe stores the values as given; :func:`random_crates` checks them when it uses them.
+
+    Examples
+    --------
+    >>> from footfall.scenarios import CrateRecipe
+    >>> recipe = CrateRecipe(count=4, region=(-2.5, -2.5, 2.5, 2.5), moving_fraction=0.5)
+    >>> recipe.forbidden_fraction, recipe.velocity_fraction, recipe.footprint_range
+    (0.5, 0.5, (0.1, 0.6))
     """
 
     count: int
@@ -238,6 +343,45 @@ def random_crates(
     then constant-velocity ones, then waypoint loops; the returned boxes are in
     that order. Raises :class:`InputError` (field ``count``) if a crate cannot
     be placed.
+
+    Parameters
+    ----------
+    terrain : Heightfield
+        The ground the crates rest on.
+    recipe : CrateRecipe
+        How many crates, where, how large and how they move.
+    seed : int
+        Seed of ``np.random.default_rng``: the same arguments always give the same crates.
+    keep_out : tuple of (x, z, radius), optional
+        World disks (m) no crate may overlap at t = 0; default none.
+    occupied : tuple of (x, z, radius), optional
+        World disks (m) already taken (e.g. hand-placed boxes); default none.
+
+    Returns
+    -------
+    Obstacles
+        ``recipe.count`` boxes resting on ``terrain`` (no ``lift``): static, then constant-velocity,
+        then waypoint loops.
+
+    Examples
+    --------
+    Four crates on flat ground, half of them moving (one at constant velocity, one on a
+    loop), none within 1 m of the origin:
+
+    >>> import numpy as np
+    >>> from footfall.scenarios import CrateRecipe, flat_heightfield, random_crates
+    >>> ground = flat_heightfield((6.0, 6.0), 0.1)
+    >>> recipe = CrateRecipe(count=4, region=(-2.5, -2.5, 2.5, 2.5), moving_fraction=0.5)
+    >>> crates = random_crates(ground, recipe, seed=1, keep_out=((0.0, 0.0, 1.0),))
+    >>> len(crates), crates.motion_kind.tolist()
+    (4, [0, 0, 1, 2])
+    >>> bool(np.all(np.hypot(crates.centres[:, 0], crates.centres[:, 2]) > 1.0))
+    True
+    >>> bool(np.allclose(crates.centres[:, 1], crates.sizes[:, 1] / 2))    # resting on the ground at y = 0
+    True
+    >>> again = random_crates(ground, recipe, seed=1, keep_out=((0.0, 0.0, 1.0),))
+    >>> bool(np.array_equal(crates.centres, again.centres))
+    True
     """
     count = recipe.count
     if isinstance(count, bool) or int(count) != count or count < 0:

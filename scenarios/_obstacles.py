@@ -42,6 +42,52 @@ class Obstacles:
     Only ``centres``, ``sizes``, ``yaws`` and ``forbidden`` are required; the
     motion fields default to "all static". Every array is copied and made
     read-only.
+
+    Attributes
+    ----------
+    centres : (n, 3) ndarray
+        World box centres (m) at t = 0.
+    sizes : (n, 3) ndarray
+        Full extents (m) along each box's local (x, y, z), all > 0.
+    yaws : (n,) ndarray
+        Rotation (radians) about +y.
+    forbidden : (n,) ndarray of bool
+        True: feet go around the box; False: safe to step on.
+    motion_kind : (n,) ndarray of int8
+        0 static, 1 constant velocity, 2 waypoint loop.
+    velocities : (n, 3) ndarray
+        World velocity (m/s) of kind-1 boxes, else zero.
+    waypoints : tuple of n (k, 3) ndarrays
+        Closed loop of world points of kind-2 boxes, else (0, 3).
+    waypoint_speed : (n,) ndarray
+        Speed (m/s) along the loop of kind-2 boxes, else 0.
+
+    Examples
+    --------
+    A static box, one sliding along +z at 0.5 m/s, and one looping between
+    two points 1 m apart at 0.5 m/s (a 2 m loop: out and back in 4 s):
+
+    >>> import numpy as np
+    >>> from footfall.scenarios import Obstacles
+    >>> boxes = Obstacles(
+    ...     centres=[[0.0, 0.25, 0.0], [2.0, 0.1, 0.0], [0.0, 0.1, 2.0]],
+    ...     sizes=[[0.5, 0.5, 0.5], [0.2, 0.2, 0.2], [0.2, 0.2, 0.2]],
+    ...     yaws=[0.0, 0.3, 0.0],
+    ...     forbidden=[False, True, True],
+    ...     motion_kind=[0, 1, 2],
+    ...     velocities=[[0.0, 0.0, 0.0], [0.0, 0.0, 0.5], [0.0, 0.0, 0.0]],
+    ...     waypoints=[np.zeros((0, 3)), np.zeros((0, 3)), [[0.0, 0.1, 2.0], [1.0, 0.1, 2.0]]],
+    ...     waypoint_speed=[0.0, 0.0, 0.5],
+    ... )
+    >>> len(boxes), boxes.is_static.tolist()
+    (3, [True, False, False])
+    >>> centres, yaws = boxes.poses_at(2.5)    # the loop: 1.25 m travelled, 0.25 m on the way back
+    >>> centres.tolist()
+    [[0.0, 0.25, 0.0], [2.0, 0.1, 1.25], [0.75, 0.1, 2.0]]
+    >>> yaws.tolist()
+    [0.0, 0.3, 0.0]
+    >>> len(Obstacles.empty())
+    0
     """
 
     centres: np.ndarray
@@ -120,7 +166,14 @@ class Obstacles:
 
     @classmethod
     def empty(cls) -> Obstacles:
-        """No obstacles at all."""
+        """No obstacles at all.
+
+        Examples
+        --------
+        >>> from footfall.scenarios import Obstacles
+        >>> Obstacles.empty().centres.shape
+        (0, 3)
+        """
         return cls(np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), np.zeros(0, bool))
 
     def __len__(self) -> int:
@@ -139,6 +192,26 @@ class Obstacles:
         ``centres + t * velocities`` (also for t < 0); waypoint boxes have
         travelled ``waypoint_speed * t`` metres along their closed loop,
         starting from waypoint 0 at t = 0. Returns fresh, writable arrays.
+
+        Parameters
+        ----------
+        t : float
+            Time (s), finite; may be negative.
+
+        Returns
+        -------
+        centres : (n, 3) ndarray
+            World box centres (m) at ``t``.
+        yaws : (n,) ndarray
+            Box yaws (radians); they never change.
+
+        Examples
+        --------
+        >>> from footfall.scenarios import Obstacles
+        >>> box = Obstacles([[0.0, 0.1, 0.0]], [[0.2, 0.2, 0.2]], [0.0], [True],
+        ...                 motion_kind=[1], velocities=[[0.5, 0.0, 0.0]])
+        >>> box.poses_at(-2.0)[0].tolist()
+        [[-1.0, 0.1, 0.0]]
         """
         t = finite_float(t, "t")
         memo = self._poses_memo

@@ -21,35 +21,49 @@ class CrowdSpawn:
 
     Attributes
     ----------
-    creature:
+    creature : str
         Built-in creature name, or path to a creature ``.toml`` (loaders store
         it already resolved against the scenario file); pass to
         :func:`scenarios.load_creature`.
-    count:
+    count : int
         Number of creatures, >= 1.
-    centre:
-        (2,) world (x, z) of the spawn disk centre, m.
-    radius:
+    centre : (2,) ndarray
+        World (x, z) of the spawn disk centre, m.
+    radius : float
         Spawn disk radius (m), >= 0 (0 with one creature: spawn at ``centre``).
-    heading:
+    heading : float
         Initial heading (radians) when ``heading_mode == "fixed"``; world
         forward is (cos heading, 0, sin heading).
-    heading_mode:
+    heading_mode : {"fixed", "random"}
         ``"fixed"``: every creature faces ``heading``; ``"random"``: each
         creature draws a heading uniformly in [-pi, pi) (see :meth:`initial_poses`).
-    speed:
+    speed : float
         Desired walking speed (m/s), > 0.
-    goal:
-        (2,) world (x, z) of the final destination, m.
-    waypoints:
-        (k, 2) world (x, z) points visited in order before ``goal`` (k may be 0).
-    feet_spacing:
-        Scale (> 0) applied to the creature's rest feet (forward, lateral).
-    gait:
+    goal : (2,) ndarray
+        World (x, z) of the final destination, m.
+    waypoints : (k, 2) ndarray
+        World (x, z) points visited in order before ``goal`` (k may be 0; None is stored as (0, 2)).
+    feet_spacing : float
+        Scale (> 0) applied to the creature's rest feet (forward, lateral); default 1.
+    gait : str or None
         The gait the crowd walks with: a built-in gait name, ``"default"``, or a path to a
         gait ``.toml`` (loaders store it already resolved against the scenario file); pass to
         :func:`scenarios.load_gait` with the creature. None: the creature's gaits
         (its default, or its built-in schedule by speed).
+
+    Examples
+    --------
+    Three ants spawned within 0.5 m of (1, 0), walking via (2, 1) to (5, 0):
+
+    >>> from footfall.scenarios import CrowdSpawn
+    >>> crowd = CrowdSpawn(creature="ant", count=3, centre=[1.0, 0.0], radius=0.5, heading=0.0,
+    ...                    heading_mode="fixed", speed=0.3, goal=[5.0, 0.0], waypoints=[[2.0, 1.0]])
+    >>> crowd.route.tolist()
+    [[2.0, 1.0], [5.0, 0.0]]
+    >>> crowd.feet_spacing, crowd.gait
+    (1.0, None)
+    >>> CrowdSpawn("ant", 1, [0.0, 0.0], 0.0, 0.0, "fixed", 0.3, [5.0, 0.0]).waypoints.shape
+    (0, 2)
     """
 
     creature: str
@@ -88,7 +102,14 @@ class CrowdSpawn:
 
     @property
     def route(self) -> np.ndarray:
-        """(k + 1, 2) world (x, z) points to walk through in order: the waypoints, then the goal."""
+        """(k + 1, 2) world (x, z) points to walk through in order: the waypoints, then the goal.
+
+        Examples
+        --------
+        >>> from footfall.scenarios import CrowdSpawn
+        >>> CrowdSpawn("ant", 1, [0.0, 0.0], 0.0, 0.0, "fixed", 0.3, goal=[5.0, 0.0]).route.tolist()
+        [[5.0, 0.0]]
+        """
         return readonly(np.vstack([self.waypoints, self.goal[None, :]]))
 
     def initial_poses(self, seed: int) -> tuple[np.ndarray, np.ndarray]:
@@ -99,6 +120,34 @@ class CrowdSpawn:
         creatures are roughly ``radius * sqrt(pi / count)`` apart. Headings are
         ``heading`` for ``"fixed"``, or drawn from ``np.random.default_rng(seed)``
         for ``"random"``.
+
+        Parameters
+        ----------
+        seed : int
+            Seed of the random headings; unused for ``"fixed"``.
+
+        Returns
+        -------
+        positions : (count, 2) ndarray
+            World (x, z) start positions, m.
+        headings : (count,) ndarray
+            Start headings, radians.
+
+        Examples
+        --------
+        Creature i starts ``radius * sqrt(i / count)`` from the centre:
+
+        >>> import numpy as np
+        >>> from footfall.scenarios import CrowdSpawn
+        >>> crowd = CrowdSpawn("ant", 3, [1.0, 0.0], 0.5, 0.0, "fixed", 0.3, [5.0, 0.0])
+        >>> positions, headings = crowd.initial_poses(seed=0)
+        >>> positions[0].tolist(), headings.tolist()
+        ([1.0, 0.0], [0.0, 0.0, 0.0])
+        >>> np.hypot(*(positions - crowd.centre).T).round(3)    # 0, 0.5 sqrt(1/3), 0.5 sqrt(2/3)
+        array([0.   , 0.289, 0.408])
+        >>> spread = CrowdSpawn("ant", 4, [0.0, 0.0], 1.0, 0.0, "random", 0.3, [5.0, 0.0])
+        >>> bool(np.array_equal(spread.initial_poses(7)[1], spread.initial_poses(7)[1]))    # same seed, same headings
+        True
         """
         i = np.arange(self.count)
         r = self.radius * np.sqrt(i / self.count)
@@ -117,10 +166,19 @@ class Camera:
 
     Attributes
     ----------
-    position, target:
-        (3,) world points, m; they must differ.
-    fov:
+    position, target : (3,) ndarray
+        World points (x, y, z), m; they must differ.
+    fov : float
         Vertical field of view (radians), 0 < fov < pi.
+
+    Examples
+    --------
+    >>> from footfall.scenarios import Camera
+    >>> camera = Camera(position=[0.0, 6.0, -9.0], target=[0.0, 0.0, 0.0], fov=0.9)
+    >>> camera.position.tolist(), camera.fov
+    ([0.0, 6.0, -9.0], 0.9)
+    >>> round(float(camera.target[1] - camera.position[1]), 1)    # y is up: it looks down
+    -6.0
     """
 
     position: np.ndarray
@@ -146,17 +204,36 @@ class Scenario:
 
     Attributes
     ----------
-    name:
+    name : str
         Scenario name.
-    source:
-        Path of the scenario file as given, or ``"builtin:NAME"``.
-    terrain, obstacles, crowd, camera:
-        The scene (see the respective classes).
-    seed:
+    source : str
+        Path of the scenario file as given, or ``"builtin:NAME"`` (a variant appends ``@key=value,...``).
+    terrain : Heightfield
+        The ground.
+    obstacles : Obstacles
+        The boxes (possibly none).
+    crowd : CrowdSpawn
+        The creatures to spawn and where they walk.
+    camera : Camera
+        The default view.
+    seed : int
         Scenario seed (>= 0), for anything random left to the simulation,
         e.g. :meth:`CrowdSpawn.initial_poses`.
-    description:
+    description : str
         Free text.
+
+    Examples
+    --------
+    Scenarios are usually loaded (:func:`load_scenario`):
+
+    >>> from footfall.scenarios import load_scenario
+    >>> scenario = load_scenario("flat")
+    >>> scenario.name, scenario.source, scenario.seed
+    ('flat', 'builtin:flat', 0)
+    >>> scenario.terrain.heights.shape, len(scenario.obstacles)    # 20 m x 20 m at 0.05 m, no boxes
+    ((401, 401), 0)
+    >>> scenario.crowd.creature, scenario.crowd.centre.tolist(), scenario.crowd.goal.tolist()
+    ('spider', [-5.0, 0.0], [5.0, 0.0])
     """
 
     name: str

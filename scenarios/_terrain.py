@@ -20,12 +20,30 @@ class Heightfield:
 
     Attributes
     ----------
-    heights:
-        (R, C) float64, m, read-only, R >= 2 and C >= 2, all finite.
-    origin_x, origin_z:
+    heights : (R, C) ndarray
+        float64, m, read-only, R >= 2 and C >= 2, all finite.
+    origin_x, origin_z : float
         World x and z (m) of ``heights[0, 0]``.
-    cell_size:
+    cell_size : float
         Grid spacing (m), > 0, the same along x and z.
+
+    Examples
+    --------
+    A 2 x 2 grid, 1 m apart: corners at x, z in {0, 1} m.
+
+    >>> import numpy as np
+    >>> from footfall.scenarios import Heightfield
+    >>> ground = Heightfield(np.array([[0.0, 1.0], [2.0, 3.0]]), origin_x=0.0, origin_z=0.0, cell_size=1.0)
+    >>> ground.x_range, ground.z_range
+    ((0.0, 1.0), (0.0, 1.0))
+    >>> float(ground.height_at(1.0, 0.0))    # heights[0, 1]: row 0 is z = 0, column 1 is x = 1
+    1.0
+    >>> float(ground.height_at(0.5, 0.5))    # bilinear: the mean of the four corners
+    1.5
+    >>> ground.contains(0.5, 0.5, margin=0.25), ground.contains(0.9, 0.5, margin=0.25)
+    (True, False)
+    >>> ground.heights.flags.writeable
+    False
     """
 
     heights: np.ndarray
@@ -53,7 +71,26 @@ class Heightfield:
         return self.origin_z, self.origin_z + (self.heights.shape[0] - 1) * self.cell_size
 
     def contains(self, x: float, z: float, margin: float = 0.0) -> bool:
-        """Whether world point (x, z) lies on the grid, at least ``margin`` m inside its border."""
+        """Whether world point (x, z) lies on the grid, at least ``margin`` m inside its border.
+
+        Parameters
+        ----------
+        x, z : float
+            World point (m).
+        margin : float, optional
+            Distance (m) the point must keep from the grid's border; 0 (default) accepts the border itself.
+
+        Returns
+        -------
+        bool
+
+        Examples
+        --------
+        >>> from footfall.scenarios import flat_heightfield
+        >>> ground = flat_heightfield((2.0, 2.0), 0.5)    # x and z in [-1, 1] m
+        >>> ground.contains(1.0, 0.0), ground.contains(1.0, 0.0, margin=0.1), ground.contains(1.5, 0.0)
+        (True, False, False)
+        """
         (x0, x1), (z0, z1) = self.x_range, self.z_range
         return x0 + margin <= x <= x1 - margin and z0 + margin <= z <= z1 - margin
 
@@ -63,6 +100,28 @@ class Heightfield:
         ``x`` and ``z`` (m) broadcast against each other; the result has their
         broadcast shape (a 0-d array for scalars). Points outside the grid take
         the height of the nearest border point. NaN coordinates give NaN.
+
+        Parameters
+        ----------
+        x, z : float or array_like
+            World coordinates (m).
+
+        Returns
+        -------
+        ndarray
+            float64 ground heights y (m), of the broadcast shape of ``x`` and ``z``.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from footfall.scenarios import Heightfield
+        >>> ground = Heightfield(np.array([[0.0, 1.0], [2.0, 3.0]]), origin_x=0.0, origin_z=0.0, cell_size=1.0)
+        >>> ground.height_at([0.0, 0.5, 5.0], 0.0)    # x = 5 m is beyond the grid: the border's height
+        array([0. , 0.5, 1. ])
+        >>> ground.height_at(0.5, [[0.0], [1.0]]).shape
+        (2, 1)
+        >>> ground.height_at(np.nan, 0.0)
+        array(nan)
         """
         x = np.asarray(x, dtype=np.float64)
         z = np.asarray(z, dtype=np.float64)

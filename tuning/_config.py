@@ -11,7 +11,33 @@ import jax
 def enable_x64() -> None:
     """Turn on float64 in JAX: tuning reproduces the runtime's float64 numbers, and keep JAX's
     compiled programs on disk (:func:`use_compilation_cache`). Called by tuning's entry points;
-    idempotent."""
+    idempotent.
+
+    Call it before creating any JAX array that should hold float64 numbers: arrays made before
+    it stay float32. It sets JAX's global configuration, so it affects the whole process.
+
+    Returns
+    -------
+    None
+
+    See Also
+    --------
+    use_compilation_cache : where the compiled programs are kept.
+
+    Examples
+    --------
+    >>> import jax
+    >>> import jax.numpy as jnp
+    >>> from footfall.tuning import enable_x64
+    >>> enable_x64()
+    >>> jax.config.jax_enable_x64
+    True
+    >>> jnp.asarray(0.1).dtype                  # float64, as the runtime computes
+    dtype('float64')
+    >>> enable_x64()                             # a second call changes nothing
+    >>> jnp.ones(2).dtype
+    dtype('float64')
+    """
     if not jax.config.jax_enable_x64:
         jax.config.update("jax_enable_x64", True)
     use_compilation_cache()

@@ -90,7 +90,56 @@ PRIOR_LOG_SCALE = 1.0
 
 
 class FitProblem(eqx.Module):
-    """Situations with their creatures' targets, per situation (F,)."""
+    """Situations with their creatures' targets, per situation (F,).
+
+    Built by :func:`make_problem`; the second argument of :func:`residuals`, :func:`loss` and
+    :func:`fit`. An ``equinox.Module`` (a pytree: ``tau`` and ``fit_timing`` are static).
+
+    Attributes
+    ----------
+    situations : Situations
+        The harvested situations (F of them, C creatures).
+    tau : float
+        Temperature of the soft selection.
+    stride_target_m, stride_tolerance, stride_mask, stride_correction : jax.Array
+        (F,) the target stride (m), its relative tolerance, the situations it applies to (new
+        swings of a moving creature) and the correction c.
+    duty_low, duty_high, duty_mask, duty_correction : jax.Array
+        (F,) the duty-factor band, the situations below its Froude limit, and the correction d.
+    max_duty_slope : jax.Array
+        () the largest allowed d DF / d(v / sqrt(g h)) (the smallest over the creatures).
+    jerk_max, curvature_max, clearance_min_m : jax.Array
+        (F,) the per-creature bounds: normalised jerk, curvature energy, clearance (m).
+    creature_one_hot : jax.Array
+        (F, C) which creature each situation belongs to.
+    log_weights0, log_timing0 : jax.Array
+        (19,) and (4,) the logs of the harvest's weights and fitted timing fields (the prior's
+        centre and the fit's start).
+    jerk_weight, offset_weight, prior_log_scale : jax.Array
+        () weights of the jerk and offset blocks, and the prior's scale.
+    slope_max, detour_max, curvature_p95_max, touchdown_clearance_m : jax.Array
+        (F,) the style's bounds (inf, or 0 for the clearance: none).
+    fit_timing : bool
+        False: the timing is held at the harvest's (a tune of the weights alone).
+
+    Examples
+    --------
+    A spider harvested with a shorter stride law (coefficient 2.0) than its targets' (2.3):
+
+    >>> from footfall.planner import GaitTiming
+    >>> from footfall.tuning import harvest_situations, load_targets, make_problem, situations_from_harvest
+    >>> harvest = harvest_situations(("flat",), ("spider",), frames=1, n_characters=1, max_situations=2,
+    ...                              timing=GaitTiming(stride_coefficient=2.0))
+    >>> situations = situations_from_harvest(harvest)
+    >>> problem = make_problem(situations, harvest.creatures, load_targets(creatures=("spider",)), tau=0.01)
+    >>> problem.tau, problem.creature_one_hot.shape
+    (0.01, (3, 1))
+    >>> bool(problem.stride_mask.all())             # three new swings of a moving spider
+    True
+    >>> target = load_targets(creatures=("spider",))["spider"].stride_length_m(float(situations.speed[0]))
+    >>> bool(abs(float(problem.stride_target_m[0]) - target) < 1e-15)
+    True
+    """
 
     situations: Situations
     tau: float = eqx.field(static=True)
@@ -130,7 +179,57 @@ def make_problem(situations: Situations, creature_names, targets, tau: float, je
     ``duty_correction``: d per situation (F,), realised - commanded duty factor (None: 0);
     ``weights_blocks``: the weights' blocks (offset, weighted ``offset_weight``, and the style's bounds
     where the targets state a style; module docstring); ``fit_timing`` False: the timing is held at the harvest's (its
-    Jacobian columns are zero and its prior keeps it there): a tune of the weights alone."""
+    Jacobian columns are zero and its prior keeps it there): a tune of the weights alone.
+
+    Parameters
+    ----------
+    situations : Situations
+        The harvested situations (:func:`situations_from_harvest`).
+    creature_names : sequence of str
+        The harvest's ``creatures``.
+    targets : dict of str to CreatureTargets
+        :func:`load_targets` output holding those creatures.
+    tau : float
+        Temperature of the soft selection, > 0.
+    jerk_weight : float, optional
+        Weight of the jerk block, >= 0 (default 0: off).
+    stride_correction, duty_correction : array_like of shape (F,), optional
+        c (positive) and d (in (-1, 1)) per situation; None: 1 and 0.
+    weights_blocks : bool, optional
+        Add the weights' blocks (default False).
+    fit_timing : bool, optional
+        Fit the timing too (default True).
+    offset_weight : float, optional
+        Weight of the offset block when ``weights_blocks`` (default 1).
+    prior_log_scale : float, optional
+        Scale of the prior on the log parameters (default :data:`PRIOR_LOG_SCALE`).
+
+    Returns
+    -------
+    FitProblem
+        The situations with their targets, per situation.
+
+    Raises
+    ------
+    ValueError
+        If ``tau`` is not > 0, ``jerk_weight`` is not a number >= 0, a creature has no targets,
+        or a correction has the wrong length or values.
+
+    Examples
+    --------
+    >>> from footfall.planner import GaitTiming
+    >>> from footfall.tuning import harvest_situations, load_targets, make_problem, situations_from_harvest
+    >>> harvest = harvest_situations(("flat",), ("spider",), frames=1, n_characters=1, max_situations=2,
+    ...                              timing=GaitTiming(stride_coefficient=2.0))
+    >>> situations = situations_from_harvest(harvest)
+    >>> problem = make_problem(situations, harvest.creatures, load_targets(creatures=("spider",)), tau=0.01)
+    >>> problem.situations.n_situations, problem.log_weights0.shape, problem.log_timing0.shape
+    (3, (19,), (4,))
+    >>> make_problem(situations, harvest.creatures, {}, tau=0.01)
+    Traceback (most recent call last):
+        ...
+    ValueError: targets: no targets for ['spider']
+    """
     if not tau > 0.0:
         raise ValueError(f"tau: expected a temperature > 0, got {tau!r}")
     if isinstance(jerk_weight, bool) or not isinstance(jerk_weight, (int, float)) or not jerk_weight >= 0.0:
@@ -205,7 +304,47 @@ def _block(values, mask):
 
 
 def residuals(params, problem: FitProblem):
-    """The residual vector (module docstring) at ``params = (log_weights, log_timing)``."""
+    """The residual vector (module docstring) at ``params = (log_weights, log_timing)``.
+
+    Blocks, in order: stride (F), duty factor (F), duty slope (1), jerk, curvature and clearance
+    (C each), the weights' blocks of :data:`WEIGHT_BLOCKS` (F each; zeros when off), and the
+    prior (19 + 4). Its length depends on F and C only.
+
+    Parameters
+    ----------
+    params : tuple of jax.Array
+        ``(log_weights (19,), log_timing (4,))``: logs of ``ScoringWeights.to_array()`` and of
+        the :data:`FITTED_TIMING` fields.
+    problem : FitProblem
+        The situations and their targets (:func:`make_problem`).
+
+    Returns
+    -------
+    jax.Array, shape (7 F + 3 C + 24,)
+        The residuals; 0 where a target is met.
+
+    Examples
+    --------
+    At the harvest's parameters only the stride block is off: each of the three new swings
+    commands a stride 2.0 / 2.3 of the target, (2.0 / 2.3 - 1) / 0.15 tolerances, the block
+    divided by the square root of its count:
+
+    >>> import jax
+    >>> from footfall.planner import GaitTiming
+    >>> from footfall.tuning import harvest_situations, load_targets, make_problem, situations_from_harvest
+    >>> harvest = harvest_situations(("flat",), ("spider",), frames=1, n_characters=1, max_situations=2,
+    ...                              timing=GaitTiming(stride_coefficient=2.0))
+    >>> situations = situations_from_harvest(harvest)
+    >>> problem = make_problem(situations, harvest.creatures, load_targets(creatures=("spider",)), tau=0.01)
+    >>> from footfall.tuning import residuals
+    >>> r = jax.jit(residuals)((problem.log_weights0, problem.log_timing0), problem)
+    >>> r.shape
+    (48,)
+    >>> [round(float(x), 4) for x in r[:3]], round((2.0 / 2.3 - 1) / 0.15 / 3 ** 0.5, 4)
+    ([-0.502, -0.502, -0.502], -0.502)
+    >>> bool((r[3:] == 0).all())
+    True
+    """
     log_weights, log_timing = params
     if not problem.fit_timing:
         log_timing = jax.lax.stop_gradient(log_timing)
@@ -269,7 +408,37 @@ def residuals(params, problem: FitProblem):
 
 
 def loss(params, problem: FitProblem):
-    """1/2 |residuals|^2."""
+    """1/2 |residuals|^2.
+
+    Parameters
+    ----------
+    params : tuple of jax.Array
+        ``(log_weights (19,), log_timing (4,))`` (:func:`residuals`).
+    problem : FitProblem
+        The situations and their targets (:func:`make_problem`).
+
+    Returns
+    -------
+    jax.Array, shape ()
+        The loss, >= 0; 0 when every target is met at the harvest's parameters.
+
+    Examples
+    --------
+    The three stride residuals of :func:`residuals`, -0.8696 / sqrt(3) each, give
+    1/2 x 0.8696^2:
+
+    >>> import jax
+    >>> from footfall.planner import GaitTiming
+    >>> from footfall.tuning import harvest_situations, load_targets, make_problem, situations_from_harvest
+    >>> harvest = harvest_situations(("flat",), ("spider",), frames=1, n_characters=1, max_situations=2,
+    ...                              timing=GaitTiming(stride_coefficient=2.0))
+    >>> situations = situations_from_harvest(harvest)
+    >>> problem = make_problem(situations, harvest.creatures, load_targets(creatures=("spider",)), tau=0.01)
+    >>> from footfall.tuning import loss
+    >>> params = (problem.log_weights0, problem.log_timing0)
+    >>> round(float(jax.jit(loss)(params, problem)), 4), round(0.5 * ((2.0 / 2.3 - 1) / 0.15) ** 2, 4)
+    (0.3781, 0.3781)
+    """
     r = residuals(params, problem)
     return 0.5 * jnp.sum(r * r)
 
@@ -299,7 +468,60 @@ def _run(params, problem: FitProblem, solver, n_steps: int):
 
 def fit(problem: FitProblem, n_steps: int = 20, solver=None):
     """Levenberg-Marquardt from the harvest's parameters. Returns (weights (19,), timing (7,),
-    loss history (n_steps,)) as numpy arrays; the loss before the fit is ``loss(initial, problem)``."""
+    loss history (n_steps,)) as numpy arrays; the loss before the fit is ``loss(initial, problem)``.
+
+    The steps run as one compiled ``lax.scan`` (a new ``n_steps`` compiles afresh). Entry ``k`` of
+    the history is the loss at the parameters after ``k + 1`` steps. The first step evaluates the
+    starting point and proposes a move, so ``history[0]`` is the initial loss and a fit needs
+    ``n_steps >= 2`` to move the parameters.
+
+    Parameters
+    ----------
+    problem : FitProblem
+        The situations and their targets (:func:`make_problem`).
+    n_steps : int, optional
+        Number of solver steps, >= 1 (default 20).
+    solver : optimistix solver, optional
+        Default ``optimistix.LevenbergMarquardt(rtol=1e-8, atol=1e-8)``.
+
+    Returns
+    -------
+    weights : numpy.ndarray, shape (19,)
+        Fitted ``ScoringWeights.to_array()``.
+    timing : numpy.ndarray, shape (7,)
+        Fitted ``GaitTiming.to_array()`` (the fields outside :data:`FITTED_TIMING` are the
+        harvest's).
+    history : numpy.ndarray, shape (n_steps,)
+        The loss after each step.
+
+    Raises
+    ------
+    ValueError
+        If ``n_steps`` is not an integer >= 1.
+
+    Examples
+    --------
+    Two steps on a spider harvested with a too short stride law (coefficient 2.0, target 2.3):
+    the loss falls, and the commanded stride at the situations' speed lengthens:
+
+    >>> from footfall.planner import GaitTiming
+    >>> from footfall.tuning import harvest_situations, load_targets, make_problem, situations_from_harvest
+    >>> harvest = harvest_situations(("flat",), ("spider",), frames=1, n_characters=1, max_situations=2,
+    ...                              timing=GaitTiming(stride_coefficient=2.0))
+    >>> situations = situations_from_harvest(harvest)
+    >>> problem = make_problem(situations, harvest.creatures, load_targets(creatures=("spider",)), tau=0.01)
+    >>> from footfall.tuning import fit
+    >>> weights, timing, history = fit(problem, n_steps=2)
+    >>> weights.shape, timing.shape, history.shape
+    ((19,), (7,), (2,))
+    >>> round(float(history[0]), 4), bool(history[1] < 0.01 * history[0])
+    (0.3781, True)
+    >>> from footfall import planner
+    >>> v, h = float(situations.speed[0]), float(situations.leg_height[0])
+    >>> before = planner.stride_length(GaitTiming(stride_coefficient=2.0), v, h)
+    >>> bool(planner.stride_length(GaitTiming.from_array(timing), v, h) > before)
+    True
+    """
     if isinstance(n_steps, bool) or not isinstance(n_steps, int) or n_steps < 1:
         raise ValueError(f"n_steps: expected an integer >= 1, got {n_steps!r}")
     solver = solver or optx.LevenbergMarquardt(rtol=1e-8, atol=1e-8)

@@ -27,6 +27,54 @@ def harvest_situations(scenarios=("mixed",), creatures=("spider",), *, seeds=(0,
     :func:`harvest_chunk`). ``map_tasks(function, tasks) -> list`` (results in task order, e.g.
     from ``footfall._distribute.task_runner``) runs them, on workers or not; None runs them here,
     one after the other. The result is the same, bit for bit, either way.
+
+    Parameters
+    ----------
+    scenarios, creatures : sequence of str
+        Built-in scenario and creature names (not a bare string), at least one of each.
+    seeds : sequence of int, optional
+        Crowd seeds, one run each (default ``(0,)``).
+    frames : int, optional
+        Frames per run, >= 1 (default 30).
+    n_characters : int, optional
+        Characters of each crowd, >= 1 (default 2).
+    weights : ScoringWeights, optional
+        The scoring weights of the runs (default ``ScoringWeights()``).
+    timing : GaitTiming, optional
+        The gait timing of the runs (default ``GaitTiming()``).
+    max_situations : int, optional
+        Stop after this many situations (whole frames); None (default): no cap.
+    map_tasks : callable, optional
+        ``map_tasks(function, tasks) -> list`` running the chunks; None: here, in order.
+
+    Returns
+    -------
+    footfall.planner.Harvest
+        Every planning request: candidates, couples, their raw numbers and the runtime's scores
+        and choices, with the ``weights`` and ``timing`` arrays used.
+
+    Raises
+    ------
+    ValueError
+        If an argument is of the wrong kind or out of range.
+
+    Examples
+    --------
+    One spider on flat ground, one frame: its first three steps (forced steps as it starts):
+
+    >>> from footfall.tuning import harvest_situations
+    >>> harvest = harvest_situations(("flat",), ("spider",), frames=1, n_characters=1, max_situations=2)
+    >>> harvest.n_situations, harvest.creatures, harvest.scenarios
+    (3, ('spider',), ('flat',))
+    >>> harvest.cand_mask.shape, harvest.couple_raw.shape            # (F, K) and (F, K, S, 5)
+    ((3, 20), (3, 20, 1, 5))
+    >>> again = harvest_situations(("flat",), ("spider",), frames=1, n_characters=1, max_situations=2)
+    >>> bool((again.couple_scores == harvest.couple_scores).all())    # seeded: the same numbers
+    True
+    >>> harvest_situations("flat")
+    Traceback (most recent call last):
+        ...
+    ValueError: scenarios, creatures: expected sequences of names
     """
     if isinstance(scenarios, str) or isinstance(creatures, str):
         raise ValueError("scenarios, creatures: expected sequences of names")
@@ -57,6 +105,37 @@ def harvest_tasks(scenarios, creatures, seeds, frames: int, n_characters: int, w
     A task carries every input of its run (names, their indices in the harvest, parameters as
     lists of floats), so it gives the same rows wherever it runs. Its cap is the global one: a
     chunk never contributes more than ``max_situations`` rows (plus the rest of its last frame).
+
+    Parameters
+    ----------
+    scenarios, creatures, seeds : sequence
+        Scenario names, creature names and seeds (:func:`harvest_situations`).
+    frames, n_characters : int
+        Frames per run and characters per crowd.
+    weights : ScoringWeights
+        The scoring weights of the runs.
+    timing : GaitTiming
+        The gait timing of the runs.
+    max_situations : int or None
+        The global cap (None: none).
+
+    Returns
+    -------
+    list of dict
+        One task per (creature, scenario, seed): creature by creature, then scenario, then seed.
+
+    Examples
+    --------
+    >>> from footfall.planner import GaitTiming, ScoringWeights
+    >>> from footfall.tuning import harvest_tasks
+    >>> tasks = harvest_tasks(("flat", "crates"), ("spider",), (0, 1), 1, 1, ScoringWeights(), GaitTiming(), None)
+    >>> len(tasks), [(t["scenario"], t["seed"]) for t in tasks]
+    (4, [('flat', 0), ('flat', 1), ('crates', 0), ('crates', 1)])
+    >>> sorted(tasks[0])
+    ['creature', 'creature_index', 'frames', 'max_situations', 'n_characters', 'scenario', 'scenario_index', 'seed',
+     'timing', 'weights']
+    >>> len(tasks[0]["weights"]), len(tasks[0]["timing"])           # plain floats
+    (19, 7)
     """
     w = [float(x) for x in weights.to_array()]
     t = [float(x) for x in timing.to_array()]
@@ -74,6 +153,27 @@ def harvest_chunk(task: dict) -> dict:
 
     Rows hold numpy arrays and :class:`footfall.planner.FootHarvest` records: picklable, for a worker
     to send back.
+
+    Parameters
+    ----------
+    task : dict
+        One task of :func:`harvest_tasks`.
+
+    Returns
+    -------
+    dict
+        ``{"rows": list, "frame_ends": list of int}``.
+
+    Examples
+    --------
+    Two frames of one spider: three requests in the first, one in the second:
+
+    >>> from footfall.planner import GaitTiming, ScoringWeights
+    >>> from footfall.tuning import harvest_chunk, harvest_tasks
+    >>> task, = harvest_tasks(("flat",), ("spider",), (0,), 2, 1, ScoringWeights(), GaitTiming(), None)
+    >>> chunk = harvest_chunk(task)
+    >>> sorted(chunk), len(chunk["rows"]), chunk["frame_ends"]
+    (['frame_ends', 'rows'], 4, [3, 4])
     """
     from footfall.scenarios import default_gait_name, load_creature, load_gait, load_scenario
 

@@ -121,7 +121,47 @@ PROXY_METRICS = ("step_length_m", "forward_offset_m", "offset_m", "touchdown_slo
 
 class Situations(eqx.Module):
     """Harvested planning situations as float64 JAX arrays (F situations, K candidates, S slices);
-    only situations with at least one couple are kept (the softmax needs one)."""
+    only situations with at least one couple are kept (the softmax needs one).
+
+    Build it with :func:`situations_from_harvest`. An ``equinox.Module``: a pytree of arrays that
+    ``jax.jit`` and ``jax.grad`` take as an argument.
+
+    Attributes
+    ----------
+    cand_mask, cand_xz, cand_centre, cand_features : jax.Array
+        Per candidate (F, K, ...): valid, footprint (x, z) (m), its cell's centre (m), raw
+        features (``planner.FEATURES``).
+    couple_mask, couple_raw : jax.Array
+        Per couple (F, K, S, ...): valid, raw trajectory metrics (``planner.RAW_METRICS``).
+    d_ref : jax.Array
+        (F, K) the length goodness's reference (m) of each candidate at the harvest's timing.
+    source, preferred, forward : jax.Array
+        Where the foot was, (x, y, z) (F, 3); the preferred footprint (x, z) at the harvest's
+        timing (F, 2); the unit heading (x, z) (F, 2).
+    speed, leg_height, relative_swing, cell_size : jax.Array
+        (F,) the creature's speed (m/s), its hip height h (m), the leg's authored swing duration
+        over the mean, and the local map's cell size (m).
+    new_swing : jax.Array
+        (F,) bool: a new swing (True) or a re-plan of a swing in progress.
+    creature : jax.Array
+        (F,) int: index in the harvest's ``creatures``.
+    timing0, weights0 : jax.Array
+        ``GaitTiming.to_array()`` (7,) and ``ScoringWeights.to_array()`` (19,) of the harvest.
+    n_situations : int
+        F.
+
+    Examples
+    --------
+    >>> from footfall.tuning import harvest_situations, situations_from_harvest
+    >>> harvest = harvest_situations(("flat",), ("spider",), frames=1, n_characters=1, max_situations=2)
+    >>> situations = situations_from_harvest(harvest)
+    >>> situations.n_situations                     # the first frame's three requests
+    3
+    >>> situations.cand_xz.shape, situations.couple_raw.shape
+    ((3, 20, 2), (3, 20, 1, 5))
+    >>> situations.timing0.shape, situations.weights0.shape
+    ((7,), (19,))
+    """
 
     cand_mask: jax.Array  # (F, K) bool
     cand_xz: jax.Array  # (F, K, 2)
@@ -148,7 +188,40 @@ class Situations(eqx.Module):
 
 
 def situations_from_harvest(harvest) -> Situations:
-    """Convert a :class:`planner.Harvest` (enables float64 in JAX)."""
+    """Convert a :class:`planner.Harvest` (enables float64 in JAX).
+
+    Situations without a valid couple are dropped; the candidates' footprints keep their
+    horizontal coordinates (x, z), and a situation is a new swing unless it re-plans a swing in
+    progress.
+
+    Parameters
+    ----------
+    harvest : footfall.planner.Harvest
+        E.g. :func:`harvest_situations` output.
+
+    Returns
+    -------
+    Situations
+        The kept situations as float64 (and bool, int) JAX arrays.
+
+    Raises
+    ------
+    ValueError
+        If the harvest's features or raw metrics do not have the runtime's widths.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from footfall.tuning import harvest_situations, situations_from_harvest
+    >>> harvest = harvest_situations(("flat",), ("spider",), frames=1, n_characters=1, max_situations=2)
+    >>> situations = situations_from_harvest(harvest)
+    >>> situations.n_situations == int(harvest.has_couple.sum())
+    True
+    >>> situations.cand_features.dtype, situations.cand_features.shape
+    (dtype('float64'), (3, 20, 5))
+    >>> bool(np.array_equal(situations.speed, harvest.speed[harvest.has_couple]))
+    True
+    """
     enable_x64()
     keep = np.asarray(harvest.has_couple)
 
@@ -170,7 +243,43 @@ def situations_from_harvest(harvest) -> Situations:
 
 
 def stride_length(timing, speed, leg_height):
-    """lambda(v) = stride_coefficient * h * Fr^stride_exponent, 0 at v = 0 (planner._timing)."""
+    """lambda(v) = stride_coefficient * h * Fr^stride_exponent, 0 at v = 0 (planner._timing).
+
+    Fr = v^2 / (g h) is the Froude number. The JAX twin of :func:`footfall.planner.stride_length`,
+    differentiable in ``timing`` (also at v = 0, where the gradient is 0).
+
+    Parameters
+    ----------
+    timing : jax.Array, shape (7,)
+        ``GaitTiming.to_array()``.
+    speed : array_like
+        Speed v (m/s), >= 0.
+    leg_height : array_like
+        Hip height h (m), > 0; broadcasts against ``speed``.
+
+    Returns
+    -------
+    jax.Array
+        The stride length lambda (m), shaped as ``speed`` and ``leg_height`` broadcast.
+
+    Examples
+    --------
+    At Fr = 1 the stride is ``stride_coefficient * h`` (2.3 x 0.12 m); the numbers are the
+    runtime's:
+
+    >>> import numpy as np
+    >>> import jax.numpy as jnp
+    >>> from footfall import planner
+    >>> from footfall.planner import GaitTiming
+    >>> from footfall.tuning import enable_x64, stride_length
+    >>> enable_x64()
+    >>> timing = jnp.asarray(GaitTiming().to_array())
+    >>> v = np.array([0.0, 0.5, (9.81 * 0.12) ** 0.5])
+    >>> [round(float(x), 4) for x in stride_length(timing, v, 0.12)]
+    [0.0, 0.1734, 0.276]
+    >>> bool(np.abs(stride_length(timing, v, 0.12) - planner.stride_length(GaitTiming(), v, 0.12)).max() < 1e-12)
+    True
+    """
     moving = speed > 0.0
     v = jnp.where(moving, speed, 1.0)  # a safe value where v = 0: Fr^b has no derivative in b at Fr = 0
     length = stride_law(timing[T_STRIDE_COEFFICIENT], timing[T_STRIDE_EXPONENT], v, leg_height)
@@ -178,7 +287,41 @@ def stride_length(timing, speed, leg_height):
 
 
 def stride_frequency(timing, speed, leg_height):
-    """f(v) = max(v / lambda(v), min_frequency_hz) where lambda > 0, else 0 (planner._timing)."""
+    """f(v) = max(v / lambda(v), min_frequency_hz) where lambda > 0, else 0 (planner._timing).
+
+    The JAX twin of :func:`footfall.planner.stride_frequency`.
+
+    Parameters
+    ----------
+    timing : jax.Array, shape (7,)
+        ``GaitTiming.to_array()``.
+    speed : array_like
+        Speed v (m/s), >= 0.
+    leg_height : array_like
+        Hip height h (m), > 0; broadcasts against ``speed``.
+
+    Returns
+    -------
+    jax.Array
+        The stride frequency f (Hz): 0 at v = 0, at least ``min_frequency_hz`` (default 0.5 Hz)
+        when moving.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import jax.numpy as jnp
+    >>> from footfall import planner
+    >>> from footfall.planner import GaitTiming
+    >>> from footfall.tuning import enable_x64, stride_frequency
+    >>> enable_x64()
+    >>> timing = jnp.asarray(GaitTiming().to_array())
+    >>> v = np.array([0.0, 0.001, 0.5])             # standing, creeping (the floor), walking
+    >>> [round(float(x), 4) for x in stride_frequency(timing, v, 0.12)]
+    [0.0, 0.5, 2.8836]
+    >>> bool(np.abs(stride_frequency(timing, v, 0.12) - planner.stride_frequency(GaitTiming(), v, 0.12)).max()
+    ...      < 1e-12)
+    True
+    """
     moving = stride_length(timing, speed, leg_height) > 0.0
     v = jnp.where(moving, speed, 1.0)
     natural = v / stride_length(timing, v, leg_height)
@@ -186,14 +329,89 @@ def stride_frequency(timing, speed, leg_height):
 
 
 def duty_factor(timing, speed, leg_height):
-    """DF(v) = clip(duty_at_rest - duty_slope * v / sqrt(g h), duty_min, duty_max) (planner._timing)."""
+    """DF(v) = clip(duty_at_rest - duty_slope * v / sqrt(g h), duty_min, duty_max) (planner._timing).
+
+    The duty factor (stance fraction of a stride cycle); the JAX twin of
+    :func:`footfall.planner.duty_factor`.
+
+    Parameters
+    ----------
+    timing : jax.Array, shape (7,)
+        ``GaitTiming.to_array()``.
+    speed : array_like
+        Speed v (m/s), >= 0.
+    leg_height : array_like
+        Hip height h (m), > 0; broadcasts against ``speed``.
+
+    Returns
+    -------
+    jax.Array
+        The duty factor DF, in [duty_min, duty_max].
+
+    Examples
+    --------
+    The defaults: 0.72 at rest, 0.72 - 0.22 = 0.5 at v = sqrt(g h), and no lower than
+    ``duty_min`` = 0.5 beyond:
+
+    >>> import numpy as np
+    >>> import jax.numpy as jnp
+    >>> from footfall import planner
+    >>> from footfall.planner import GaitTiming
+    >>> from footfall.tuning import duty_factor, enable_x64
+    >>> enable_x64()
+    >>> timing = jnp.asarray(GaitTiming().to_array())
+    >>> v = np.array([0.0, 1.0, 2.0]) * (9.81 * 0.12) ** 0.5
+    >>> [round(float(x), 4) for x in duty_factor(timing, v, 0.12)]
+    [0.72, 0.5, 0.5]
+    >>> bool(np.abs(duty_factor(timing, v, 0.12) - planner.duty_factor(GaitTiming(), v, 0.12)).max() < 1e-12)
+    True
+    """
     raw = duty_law(timing[T_DUTY_AT_REST], timing[T_DUTY_SLOPE], speed, jnp.sqrt(GRAVITY * leg_height))
     return jnp.clip(raw, timing[T_DUTY_MIN], timing[T_DUTY_MAX])
 
 
 def preferred_lead_time(timing, speed, leg_height, relative_swing, new_swing):
     """g = t_swing + t_stance / 2 (s, steady state; module docstring): P leads by v * g.
-    A re-plan's t_swing does not depend on the timing and is left out (only differences matter)."""
+    A re-plan's t_swing does not depend on the timing and is left out (only differences matter).
+
+    t_stance = DF / f and, for a new swing, t_swing = min(clip((1 - DF) r, 0.05, 0.95) / f, 1),
+    with f floored at :data:`LEAST_FREQUENCY_HZ`.
+
+    Parameters
+    ----------
+    timing : jax.Array, shape (7,)
+        ``GaitTiming.to_array()``.
+    speed, leg_height : array_like
+        Speed v (m/s) and hip height h (m).
+    relative_swing : array_like
+        r: the leg's authored swing duration over the gait's mean.
+    new_swing : array_like of bool
+        A new swing (True) or a re-plan (False: no t_swing term).
+
+    Returns
+    -------
+    jax.Array
+        The lead time g (s), shaped as the inputs broadcast.
+
+    Examples
+    --------
+    At 0.5 m/s with h = 0.12 m, the runtime's f and DF give the same lead time by hand:
+
+    >>> import jax.numpy as jnp
+    >>> from footfall import planner
+    >>> from footfall.planner import GaitTiming
+    >>> from footfall.tuning import enable_x64, preferred_lead_time
+    >>> enable_x64()
+    >>> timing = jnp.asarray(GaitTiming().to_array())
+    >>> f = planner.stride_frequency(GaitTiming(), 0.5, 0.12)
+    >>> df = planner.duty_factor(GaitTiming(), 0.5, 0.12)
+    >>> by_hand = min(min(max(1.0 - df, 0.05), 0.95) / f, 1.0) + 0.5 * df / f
+    >>> g = preferred_lead_time(timing, 0.5, 0.12, 1.0, True)
+    >>> round(float(g), 4), bool(abs(float(g) - by_hand) < 1e-12)
+    (0.2395, True)
+    >>> round(float(preferred_lead_time(timing, 0.5, 0.12, 1.0, False)), 4)   # a re-plan: DF / (2 f)
+    0.1073
+    """
     frequency = jnp.maximum(stride_frequency(timing, speed, leg_height), LEAST_FREQUENCY_HZ)
     duty = duty_factor(timing, speed, leg_height)
     swing = jnp.clip((1.0 - duty) * relative_swing, SWING_MIN, SWING_MAX)
@@ -202,7 +420,40 @@ def preferred_lead_time(timing, speed, leg_height, relative_swing, new_swing):
 
 
 def preferred_footprint(timing, situations: Situations):
-    """(F, 2) the preferred footprint at timing ``theta``; = the harvest's at theta_0."""
+    """(F, 2) the preferred footprint at timing ``theta``; = the harvest's at theta_0.
+
+    P moves along each situation's heading by v (g(theta) - g(theta_0)), g the
+    :func:`preferred_lead_time`.
+
+    Parameters
+    ----------
+    timing : jax.Array, shape (7,)
+        ``GaitTiming.to_array()`` theta.
+    situations : Situations
+        The harvested situations (their ``timing0`` is theta_0).
+
+    Returns
+    -------
+    jax.Array, shape (F, 2)
+        The preferred footprints (x, z) (m).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from footfall.tuning import harvest_situations, preferred_footprint, situations_from_harvest
+    >>> harvest = harvest_situations(("flat",), ("spider",), frames=1, n_characters=1, max_situations=2)
+    >>> s = situations_from_harvest(harvest)
+    >>> bool(np.array_equal(preferred_footprint(s.timing0, s), harvest.preferred[harvest.has_couple]))
+    True
+
+    A longer stride law (stride_coefficient 2.3 -> 2.6) means a lower stride frequency, longer
+    stance and swing times, so P moves ahead along the heading:
+
+    >>> moved = preferred_footprint(s.timing0.at[0].set(2.6), s)
+    >>> ahead = ((moved - s.preferred) * s.forward).sum(axis=1)
+    >>> bool((ahead > 0).all())
+    True
+    """
     s = situations
     args = (s.speed, s.leg_height, s.relative_swing, s.new_swing)
     shift = s.speed * (preferred_lead_time(timing, *args) - preferred_lead_time(s.timing0, *args))
@@ -243,7 +494,43 @@ def moved_paths(situations: Situations, x):
 
 
 def couple_scores(weights, timing, situations: Situations):
-    """(F, K, S) couple scores at weights ``w`` and timing ``theta`` (invalid couples: -inf)."""
+    """(F, K, S) couple scores at weights ``w`` and timing ``theta`` (invalid couples: -inf).
+
+    Each candidate's footprint follows the :func:`preferred_footprint` inside its cell (the
+    distance feature and the path lengths move with it); every other raw number is the
+    harvest's. At the harvest's timing these are the runtime's scores.
+
+    Parameters
+    ----------
+    weights : jax.Array, shape (19,)
+        ``ScoringWeights.to_array()`` w.
+    timing : jax.Array, shape (7,)
+        ``GaitTiming.to_array()`` theta.
+    situations : Situations
+        The harvested situations.
+
+    Returns
+    -------
+    jax.Array, shape (F, K, S)
+        :func:`couple_score` of every couple; -inf where ``situations.couple_mask`` is False.
+
+    Examples
+    --------
+    At the harvest's parameters the scores are the runtime's (numba) ones:
+
+    >>> import numpy as np
+    >>> from footfall.tuning import couple_scores, harvest_situations, situations_from_harvest
+    >>> harvest = harvest_situations(("flat",), ("spider",), frames=1, n_characters=1, max_situations=2)
+    >>> s = situations_from_harvest(harvest)
+    >>> scores = np.asarray(couple_scores(s.weights0, s.timing0, s))
+    >>> scores.shape
+    (3, 20, 1)
+    >>> valid = harvest.couple_mask[harvest.has_couple]
+    >>> bool(np.abs(scores[valid] - harvest.couple_scores[harvest.has_couple][..., 0][valid]).max() < 1e-12)
+    True
+    >>> bool(np.isneginf(scores[~valid]).all())
+    True
+    """
     s = situations
     pref = preferred_footprint(timing, s)
     x = footprints(s, pref)
@@ -255,7 +542,38 @@ def couple_scores(weights, timing, situations: Situations):
 
 
 def soft_selection(scores, mask, tau):
-    """(F, K, S) probabilities softmax(score / tau) over the valid couples of each situation."""
+    """(F, K, S) probabilities softmax(score / tau) over the valid couples of each situation.
+
+    The largest valid score is subtracted first (outside the gradient) so that the exponentials
+    never overflow; invalid couples get probability 0.
+
+    Parameters
+    ----------
+    scores : jax.Array, shape (F, K, S)
+        Couple scores (:func:`couple_scores`; invalid entries may be -inf).
+    mask : jax.Array, shape (F, K, S)
+        Valid couples; every situation needs at least one.
+    tau : float
+        Temperature, > 0: a couple scoring tau less than another weighs e^-1 as much.
+
+    Returns
+    -------
+    jax.Array, shape (F, K, S)
+        Probabilities summing to 1 over each situation's couples.
+
+    Examples
+    --------
+    >>> import math
+    >>> import jax.numpy as jnp
+    >>> from footfall.tuning import enable_x64, soft_selection
+    >>> enable_x64()
+    >>> p = soft_selection(jnp.array([[[0.5], [0.4]]]), jnp.ones((1, 2, 1), dtype=bool), 0.1)
+    >>> round(float(p[0, 1, 0] / p[0, 0, 0]), 4), round(math.exp(-1), 4)   # 0.1 lower: e^-1 as likely
+    (0.3679, 0.3679)
+    >>> p = soft_selection(jnp.array([[[0.5, 0.5], [0.4, 0.9]]]), jnp.array([[[True, True], [True, False]]]), 0.1)
+    >>> [round(float(x), 4) for x in p.ravel()]     # the masked 0.9 gets nothing
+    [0.4223, 0.4223, 0.1554, 0.0]
+    """
     flat = scores.reshape(scores.shape[0], -1)
     valid = mask.reshape(flat.shape)
     top = jax.lax.stop_gradient(jnp.max(jnp.where(valid, flat, -jnp.inf), axis=1, keepdims=True))
@@ -266,7 +584,62 @@ def soft_selection(scores, mask, tau):
 def expected_metrics(weights, timing, situations: Situations, tau, clearance_cap_m=jnp.inf, touchdown_cap_m=None):
     """Expectations under the soft selection at temperature ``tau`` (> 0): a dict of (F,)
     arrays keyed by :data:`PROXY_METRICS`. ``touchdown_cap_m``: the cap of ``touchdown_clearance_m``
-    (a number or (F,); None: ``clearance_cap_m``)."""
+    (a number or (F,); None: ``clearance_cap_m``).
+
+    Smooth in the weights and the timing: the differentiable stand-in for the metrics of the
+    couple the runtime picks (:func:`hard_metrics`), which it tends to as tau -> 0 away from
+    ties.
+
+    Parameters
+    ----------
+    weights : jax.Array, shape (19,)
+        ``ScoringWeights.to_array()`` w.
+    timing : jax.Array, shape (7,)
+        ``GaitTiming.to_array()`` theta.
+    situations : Situations
+        The harvested situations.
+    tau : float
+        Temperature of :func:`soft_selection`, > 0 (module docstring: 0.01 to 0.05).
+    clearance_cap_m : float or jax.Array, optional
+        Cap (m) of the path clearance, a number or (F,); default +inf (no cap).
+    touchdown_cap_m : float or jax.Array, optional
+        Cap (m) of ``touchdown_clearance_m``; None: ``clearance_cap_m``.
+
+    Returns
+    -------
+    dict of str to jax.Array
+        One (F,) array per key of :data:`PROXY_METRICS`.
+
+    Examples
+    --------
+    >>> import jax
+    >>> import jax.numpy as jnp
+    >>> from footfall.tuning import expected_metrics, harvest_situations, situations_from_harvest
+    >>> harvest = harvest_situations(("flat",), ("spider",), frames=1, n_characters=1, max_situations=2)
+    >>> s = situations_from_harvest(harvest)
+    >>> metrics = expected_metrics(s.weights0, s.timing0, s, 0.01)
+    >>> len(metrics), metrics["step_length_m"].shape
+    (13, (3,))
+
+    The expected couple score is at most the best couple's; as tau -> 0 the expectation becomes
+    the metric of the best couple (:func:`hard_metrics`):
+
+    >>> from footfall.tuning import hard_metrics
+    >>> hard = hard_metrics(s.weights0, s.timing0, s)
+    >>> bool((metrics["couple_score"] <= hard["couple_score"]).all())
+    True
+    >>> cold = expected_metrics(s.weights0, s.timing0, s, 1e-6)
+    >>> bool(jnp.allclose(cold["step_length_m"], hard["step_length_m"], rtol=1e-9))
+    True
+
+    The gradient of the expected offset from the preferred footprint reaches the weights (finite,
+    not all zero), which the argmax's does not:
+
+    >>> offset = jax.jit(jax.grad(lambda w: expected_metrics(w, s.timing0, s, 0.01)["offset_m"].sum()))
+    >>> grad = offset(s.weights0)
+    >>> grad.shape, bool(jnp.isfinite(grad).all()), bool((grad != 0).any())
+    ((19,), True, True)
+    """
     scores = couple_scores(weights, timing, situations)
     p = soft_selection(scores, situations.couple_mask, tau)
     return _metrics_under(p, scores, timing, situations, clearance_cap_m, touchdown_cap_m)
@@ -274,7 +647,44 @@ def expected_metrics(weights, timing, situations: Situations, tau, clearance_cap
 
 def hard_metrics(weights, timing, situations: Situations, clearance_cap_m=jnp.inf):
     """The same metrics at the argmax couple of each situation (first maximum in the search's
-    order, as the exhaustive search picks): the tau -> 0 limit away from ties."""
+    order, as the exhaustive search picks): the tau -> 0 limit away from ties.
+
+    The choice is piecewise constant in the weights (a gradient does not go through it): for
+    reporting and checking, not for fitting.
+
+    Parameters
+    ----------
+    weights : jax.Array, shape (19,)
+        ``ScoringWeights.to_array()`` w.
+    timing : jax.Array, shape (7,)
+        ``GaitTiming.to_array()`` theta.
+    situations : Situations
+        The harvested situations.
+    clearance_cap_m : float or jax.Array, optional
+        Cap (m) of the path clearance (and of the touch-down clearance), a number or (F,);
+        default +inf.
+
+    Returns
+    -------
+    dict of str to jax.Array
+        One (F,) array per key of :data:`PROXY_METRICS`, at the best couple.
+
+    Examples
+    --------
+    At the harvest's parameters the best couple's score is the one the runtime's exhaustive
+    search found:
+
+    >>> import numpy as np
+    >>> from footfall.tuning import hard_metrics, harvest_situations, situations_from_harvest
+    >>> harvest = harvest_situations(("flat",), ("spider",), frames=1, n_characters=1, max_situations=2)
+    >>> s = situations_from_harvest(harvest)
+    >>> hard = hard_metrics(s.weights0, s.timing0, s)
+    >>> runtime = harvest.chosen_scores[harvest.has_couple, 0]
+    >>> bool(np.abs(np.asarray(hard["couple_score"]) - runtime).max() < 1e-12)
+    True
+    >>> [round(float(x), 4) for x in hard["step_length_m"]]
+    [0.0893, 0.0892, 0.179]
+    """
     s = situations
     scores = couple_scores(weights, timing, s)
     flat = scores.reshape(scores.shape[0], -1)

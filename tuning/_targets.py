@@ -84,7 +84,28 @@ STYLE_FIELDS: dict[str, tuple[float | None, float | None, bool]] = {
 
 @dataclass(frozen=True)
 class Target:
-    """One target: its dimensionless numbers and where they come from."""
+    """One target: its dimensionless numbers and where they come from.
+
+    Attributes
+    ----------
+    quantity : str
+        One of :data:`QUANTITIES`, e.g. ``"stride_length"``.
+    values : dict of str to float
+        The quantity's fields (module docstring), dimensionless.
+    source : str
+        The key of ``[sources]`` the numbers come from.
+    citation : str
+        That source's citation.
+
+    Examples
+    --------
+    >>> from footfall.tuning import load_targets
+    >>> target = load_targets(creatures=("spider",))["spider"]["duty_factor"]
+    >>> target.quantity, target.values
+    ('duty_factor', {'low': 0.6, 'high': 0.75, 'froude_max': 1.0})
+    >>> target.source, target.citation
+    ('spagna_2011', "Spagna, Valdivia & Mohan 2011, J Arachnol 39:84: spiders' duty factor ...")
+    """
 
     quantity: str
     values: dict[str, float]
@@ -94,7 +115,47 @@ class Target:
 
 @dataclass(frozen=True)
 class CreatureTargets:
-    """Every quantity's target for one creature, with its leg length h (m)."""
+    """Every quantity's target for one creature, with its leg length h (m).
+
+    ``targets[quantity]`` (or ``creature_targets[quantity]``) is that quantity's :class:`Target`;
+    the methods turn the dimensionless numbers into metres with h.
+
+    Attributes
+    ----------
+    creature : str
+        The creature's name.
+    leg_length_m : float
+        h (m): the creature's hip height standing, the leg length of the Froude number.
+    targets : dict of str to Target
+        One target per quantity of :data:`QUANTITIES`.
+    style : dict of str to float or None
+        A user's style (``STYLE_FIELDS`` keys), or None when none is stated.
+    file : str or None
+        The targets file these came from (None: the shipped one).
+    clearance_min_m : float
+        The clearance target's minimum times h (m).
+    stride_law : tuple of float
+        (coefficient, exponent) of lambda / h = coefficient Fr^exponent.
+    citations : dict of str to str
+        The citation of each quantity's target.
+
+    Examples
+    --------
+    At Fr = 1 (v = sqrt(g h)) the target stride is coefficient x h = 2.3 x 0.12 m:
+
+    >>> from footfall.tuning import load_targets
+    >>> spider = load_targets(creatures=("spider",))["spider"]
+    >>> spider.creature, spider.leg_length_m, spider.stride_law
+    ('spider', 0.12, (2.3, 0.3))
+    >>> round(spider.stride_length_m((9.81 * 0.12) ** 0.5), 4)
+    0.276
+    >>> spider.stride_law_text(), round(spider.clearance_min_m, 4)        # clearance: 0.25 h
+    ('2.3 h Fr^0.3', 0.03)
+    >>> spider["swing_jerk"].values
+    {'minimum': 720.0, 'maximum': 1000.0}
+    >>> spider.timing().stride_coefficient       # a GaitTiming that commands the target law
+    2.3
+    """
 
     creature: str
     leg_length_m: float
@@ -185,7 +246,43 @@ def _target(file: str, where: str, quantity: str, entry, sources: dict[str, str]
 
 
 def load_targets(path: str | Path = TARGETS_FILE, creatures=None) -> dict[str, CreatureTargets]:
-    """Targets per creature (default: every built-in creature), with every quantity."""
+    """Targets per creature (default: every built-in creature), with every quantity.
+
+    The file's ``[defaults]`` apply to every creature; a ``[creatures.<name>.<quantity>]`` entry
+    replaces that quantity's whole entry for that creature. Each creature's leg length h is its
+    hip height standing (:func:`footfall.planner.hip_height`).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path, optional
+        A whole targets file (default :data:`TARGETS_FILE`, the shipped one).
+    creatures : sequence of str, optional
+        Built-in creature names; None (default): every built-in creature.
+
+    Returns
+    -------
+    dict of str to CreatureTargets
+        Per creature name.
+
+    Raises
+    ------
+    footfall.InputError
+        If the file cannot be read or is malformed (naming the file and the field), or names an
+        unknown creature.
+
+    Examples
+    --------
+    >>> from footfall.tuning import load_targets
+    >>> targets = load_targets()
+    >>> sorted(targets)
+    ['ant', 'quadruped', 'robot5', 'spider']
+    >>> targets["ant"]["duty_factor"].values["low"], targets["robot5"]["duty_factor"].values["low"]   # override
+    (0.45, 0.55)
+    >>> load_targets("no_such_file.toml")
+    Traceback (most recent call last):
+        ...
+    footfall._errors.InputError: no_such_file.toml: targets: cannot read file: No such file or directory
+    """
     file = str(path)
     try:
         data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
