@@ -64,6 +64,7 @@ from footfall.planner._lod import (
 )
 from footfall.planner._maps import WorldRaster
 from footfall.planner._params import PlannerConfig, SearchBudget
+from footfall.planner._timing import stance_lead
 from footfall.planner._weights import ScoringWeights
 
 DT = 1.0 / 30.0
@@ -1378,7 +1379,7 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     # throws it out to keep the leg's length), and that foot landed a cell short, then a cell long.
     ground_drop = drop - scale * (slope_forward * offset[:, 0] + slope_left * offset[:, 1])
     ox, oz = _rot_xz(heading, scale * offset[:, 0], scale * offset[:, 1])
-    preferred = hip_pred + np.stack([ox, oz], axis=1) + fwd * (0.5 * sweep)[:, None]
+    preferred = hip_pred + np.stack([ox, oz], axis=1) + fwd * stance_lead(sweep)[:, None]
     foot_yaw = np.arctan2(preferred[:, 1] - hip_pred[:, 1], preferred[:, 0] - hip_pred[:, 0])
     # The other legs at touchdown time: their hips carried forward with the pelvis, their feet
     # where they stand (or will land). Mixing predicted and current hips would make legs

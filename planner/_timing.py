@@ -150,6 +150,35 @@ def duty_law(at_rest, slope, v, root_gh):
     0.28
     """
     return at_rest - slope * v / root_gh
+
+
+@register_jitable
+def stance_lead(stance):
+    """How far a new swing's preferred footprint lies ahead of its hip at touchdown: half the stance
+    to come, so that the stance sweeps the foot's window evenly about its rest point.
+
+    One law for two users: the runtime places a footprint ``stance_lead(sweep)`` metres ahead of the
+    touchdown pose (``planner._crowd.stage_plan``, ``sweep`` the distance the body covers during the
+    stance), and the tuning's proxy takes the lead time ``t_swing + stance_lead(t_stance)`` seconds
+    (``footfall.tuning.preferred_lead_time``: the steady-state limit, where distance = speed x time).
+
+    Parameters
+    ----------
+    stance : float or ndarray
+        The stance to come: a distance (m) or a duration (s).
+
+    Returns
+    -------
+    float or ndarray
+        Half of it, in the same unit.
+
+    Examples
+    --------
+    >>> from footfall.planner import stance_lead
+    >>> stance_lead(0.12)   # a 12 cm stance sweep: the footprint leads the touchdown hip by 6 cm
+    0.06
+    """
+    return 0.5 * stance
 SWING_MIN = 0.05
 """Least swing fraction of a speed-scaled disk."""
 SWING_MAX = 0.95

@@ -67,7 +67,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from footfall.planner import GRAVITY, SWING_MAX, SWING_MIN, duty_law, stride_law
+from footfall.planner import GRAVITY, SWING_MAX, SWING_MIN, duty_law, stance_lead, stride_law
 from footfall.planner.layout import (
     FEAT_DISTANCE,
     FEAT_PROXIMITY,
@@ -416,7 +416,8 @@ def preferred_lead_time(timing, speed, leg_height, relative_swing, new_swing):
     duty = duty_factor(timing, speed, leg_height)
     swing = jnp.clip((1.0 - duty) * relative_swing, SWING_MIN, SWING_MAX)
     t_swing = jnp.where(new_swing, jnp.minimum(swing / frequency, 1.0), 0.0)
-    return t_swing + 0.5 * duty / frequency
+    # 0.5 * (DF / f) is (0.5 * DF) / f bit for bit: halving is exact.
+    return t_swing + stance_lead(duty / frequency)
 
 
 def preferred_footprint(timing, situations: Situations):
