@@ -309,3 +309,20 @@ def test_guards_allow_the_higher_of_the_defaults_and_a_mis_tuned_start():
     worse = dataclasses.replace(mended, jerk_median=2.5)
     accepted, why = _accept(worse, start, default, gain_noise_se=0.0, start=start)
     assert not accepted and "jerk" in why
+
+
+def test_a_checkpoint_round_trips_through_json_and_names_a_broken_field(tmp_path):
+    from footfall.tuning._tune import BestSoFar, TuneCheckpoint, _default_params
+
+    params = _default_params()
+    exact = _metrics([1.0, 2.0], 1.5)
+    state = TuneCheckpoint(config={"creature": "spider"}, round=1, stopped=False, current=params, current_exact=exact,
+                           best=BestSoFar(params, exact, 0), start_exact=exact, default_exact=None,
+                           history=({"round": 0, "accepted": True},))
+    data = json.loads(json.dumps(state.to_json()))
+    assert TuneCheckpoint.from_json(data, tmp_path / "c.json") == state
+    for change, field in ((dict(best=[1]), "best"), (dict(round="x"), "round"), (dict(history=3), "history"),
+                          (dict(current_exact=dict(data["current_exact"], runs=5)), "current_exact"),
+                          (dict(current={"weights": [1.0]}), "params")):
+        with pytest.raises(InputError, match=f"c.json: {field}: corrupt checkpoint"):
+            TuneCheckpoint.from_json(dict(data, **change), tmp_path / "c.json")

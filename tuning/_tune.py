@@ -490,8 +490,10 @@ class TuneCheckpoint:
                     "history"):
             if key not in data:
                 raise InputError(path, key, "corrupt checkpoint: missing field")
+        if not isinstance(data["best"], dict):
+            raise InputError(path, "best", "corrupt checkpoint: expected an object")
         exact = {}
-        for key, value in (("current_exact", data["current_exact"]), ("best.exact", (data["best"] or {}).get("exact")),
+        for key, value in (("current_exact", data["current_exact"]), ("best.exact", data["best"].get("exact")),
                            ("start_exact", data["start_exact"]), ("default_exact", data["default_exact"])):
             if value is None and key == "default_exact":
                 exact[key] = None
@@ -506,7 +508,10 @@ class TuneCheckpoint:
                 _objects(p)
         except (KeyError, TypeError, ValueError) as e:
             raise InputError(path, "params", f"corrupt checkpoint: {e}") from None
-        return cls(config=data["config"], round=int(data["round"]), stopped=bool(data["stopped"]),
+        for key, kind in (("round", int), ("stopped", bool), ("history", list)):
+            if not isinstance(data[key], kind):
+                raise InputError(path, key, f"corrupt checkpoint: expected {kind.__name__}")
+        return cls(config=data["config"], round=data["round"], stopped=data["stopped"],
                    current=data["current"], current_exact=exact["current_exact"], best=best,
                    start_exact=exact["start_exact"], default_exact=exact["default_exact"],
                    history=tuple(data["history"]))
