@@ -396,3 +396,25 @@ def test_the_offset_block_is_off_only_for_a_style_with_a_clearance_bound():
                                                            "min_clearance_body_heights": 2.0})) == 0.0
     for name, weight in (("cautious", 0.0), ("sure-footed", 1.0), ("direct", 1.0)):
         assert offset_weight(load_tune_targets(STYLES / f"{name}.toml", "spider")) == weight, name
+
+
+def test_the_events_checkpoint_round_trips_and_names_a_broken_field(tmp_path):
+    from footfall.tuning._tune import BestSoFar, _default_params
+    from footfall.tuning._tune_events import EventTuneCheckpoint
+
+    params = _default_params()
+    metrics = {"exact_loss": 0.5, "stride_rel_error": math.nan, "collisions": 0, "finite": True,
+               "means": {"stride_error": None}, "runs": [{"run_loss": 0.5, "stride_error": math.nan}]}
+    state = EventTuneCheckpoint(config={"creature": "spider"}, round=1, stopped=True, current=params,
+                                best=BestSoFar(params, metrics, 0), default_exact=metrics, history=({"round": 0},))
+    data = json.loads(json.dumps(state.to_json(), allow_nan=False))  # NaN is written as null
+    assert data["best"]["exact"]["stride_rel_error"] is None
+    back = EventTuneCheckpoint.from_json(data, tmp_path / "e.json")
+    assert back == state.through_json() and back.to_json() == data
+    for change, field in ((dict(best={"params": params}), "best"), (dict(round=1.5), "round"),
+                          (dict(history={}), "history"), (dict(current={"weights": [1.0]}), "params")):
+        with pytest.raises(InputError, match=f"e.json: {field}: corrupt checkpoint"):
+            EventTuneCheckpoint.from_json(dict(data, **change), tmp_path / "e.json")
+    broken = {k: v for k, v in data.items() if k != "default_exact"}
+    with pytest.raises(InputError, match="default_exact: corrupt checkpoint: missing field"):
+        EventTuneCheckpoint.from_json(broken, tmp_path / "e.json")

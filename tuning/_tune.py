@@ -450,10 +450,12 @@ def spearman_proxy_exact(config: TuneConfig, params: dict, map_tasks=None) -> tu
 
 @dataclass(frozen=True)
 class BestSoFar:
-    """The best parameters the outer loop accepted, their exact metrics, and the round (-1: the start)."""
+    """The best parameters the outer loop accepted, their exact metrics, and the round (-1: the start).
+    ``exact``: :class:`ExactMetrics` in the speed-sweep tune, the event metrics' record in the terrain
+    and style tune (``tuning._tune_events.EventTuneCheckpoint``)."""
 
     params: dict
-    exact: ExactMetrics
+    exact: ExactMetrics | dict
     round: int
 
 

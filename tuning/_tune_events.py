@@ -41,8 +41,8 @@ from footfall._atomic import write_text_atomic
 from footfall._errors import InputError
 from footfall.tuning._events import (EVENT_FRAMES, SPAWN_FRACTIONS, EventSetup, collisions_rise, event_metrics, paired,
                             spawn_variant)
-from footfall.tuning._tune import (LINE_SEARCH, TuneResult, _bucket, _floats, _objects, _pad_problem, _towards, check_creature,
-                          check_output, checkpoint_path)
+from footfall.tuning._tune import (LINE_SEARCH, BestSoFar, TuneResult, _bucket, _floats, _objects, _pad_problem, _towards,
+                          check_creature, check_output, checkpoint_path)
 
 CHECKPOINT_FORMAT = "footfall-tune-events-checkpoint"
 CHECKPOINT_VERSION = 1
@@ -241,7 +241,58 @@ def _clean(value):
     return value
 
 
-def _load(path: Path, config: EventTuneConfig) -> dict:
+@dataclass(frozen=True)
+class EventTuneCheckpoint:
+    """The terrain / style tune's state after a round, as its checkpoint file holds it. Each round
+    makes a new one (``dataclasses.replace``). The metrics (``best.exact``, ``default_exact``) are
+    :func:`tuning._events.event_metrics` records: per-run metrics of the targets' style, kept as
+    the plain records the preset's provenance and ``tuning/data/matrix.json`` store. ``to_json``
+    gives the file's fields in this order with NaN written as null; ``from_json`` reads them back."""
+
+    config: dict  # EventTuneConfig.to_json(): a resume with other settings is refused
+    round: int  # rounds done
+    stopped: bool  # the line search found no better step: the loop ends
+    current: dict  # the parameters the next round starts from
+    best: BestSoFar
+    default_exact: dict  # the defaults' event metrics (the guards' reference)
+    history: tuple[dict, ...]  # one record per round (fit, line search, decision)
+
+    def to_json(self) -> dict:
+        return _clean({"format": CHECKPOINT_FORMAT, "version": CHECKPOINT_VERSION, "config": self.config,
+                       "round": self.round, "stopped": self.stopped, "current": self.current,
+                       "best": {"params": self.best.params, "exact": self.best.exact, "round": self.best.round},
+                       "default_exact": self.default_exact, "history": list(self.history)})
+
+    @classmethod
+    def from_json(cls, data: dict, path: Path) -> "EventTuneCheckpoint":
+        """The checkpoint of a file's JSON; anything missing or of the wrong kind raises
+        :class:`InputError` naming the file and the field."""
+        kinds = (("config", dict), ("round", int), ("stopped", bool), ("current", dict), ("best", dict),
+                 ("default_exact", dict), ("history", list))
+        for key, kind in kinds:
+            if key not in data:
+                raise InputError(path, key, "corrupt checkpoint: missing field")
+            if not isinstance(data[key], kind):
+                raise InputError(path, key, f"corrupt checkpoint: expected {kind.__name__}")
+        best = data["best"]
+        if not (isinstance(best.get("params"), dict) and isinstance(best.get("exact"), dict)
+                and isinstance(best.get("round"), int)):
+            raise InputError(path, "best", "corrupt checkpoint: expected params, exact and round")
+        try:
+            for p in (data["current"], best["params"]):
+                _objects(p)
+        except (KeyError, TypeError, ValueError) as e:
+            raise InputError(path, "params", f"corrupt checkpoint: {e}") from None
+        return cls(config=data["config"], round=data["round"], stopped=data["stopped"], current=data["current"],
+                   best=BestSoFar(best["params"], best["exact"], best["round"]), default_exact=data["default_exact"],
+                   history=tuple(data["history"]))
+
+    def through_json(self) -> "EventTuneCheckpoint":
+        """This state as a resume reads it back (NaN as None): the loop goes on from exactly that."""
+        return EventTuneCheckpoint.from_json(self.to_json(), Path(CHECKPOINT_FORMAT))
+
+
+def _load(path: Path, config: EventTuneConfig) -> EventTuneCheckpoint:
     if not path.exists():
         raise InputError(path, "checkpoint", "no checkpoint to resume from (run without --resume first)")
     try:
@@ -253,10 +304,10 @@ def _load(path: Path, config: EventTuneConfig) -> dict:
     if state.get("version") != CHECKPOINT_VERSION:
         raise InputError(path, "version", f"expected {CHECKPOINT_VERSION}, got {state.get('version')!r}")
     if state.get("config") != config.to_json():
-        theirs = state.get("config") or {}
+        theirs = state.get("config") if isinstance(state.get("config"), dict) else {}
         diff = sorted(k for k, v in config.to_json().items() if theirs.get(k) != v)
         raise InputError(path, "config", f"the checkpoint was made with other settings ({', '.join(diff)})")
-    return state
+    return EventTuneCheckpoint.from_json(state, path)
 
 
 def weights_max_rel_change(tuned: dict, default: dict) -> float:
@@ -299,56 +350,51 @@ def _run(config, out, resume, progress, stop_after, write, map_tasks, t0, spearm
     start = _start(targets)
     if resume:
         state = _load(ckpt, config)
-        say(f"resumed at round {state['round']}", state["round"] + 1, total)
+        say(f"resumed at round {state.round}", state.round + 1, total)
     else:
         say("objective of the defaults", 0, total)
         default_exact = event_metrics(setup, *_objects(start), targets, map_tasks)
-        state = {"format": CHECKPOINT_FORMAT, "version": CHECKPOINT_VERSION, "config": config.to_json(), "round": 0,
-                 "stopped": False, "current": style_start(start, targets),
-                 "best": {"params": start, "exact": default_exact, "round": -1},
-                 "default_exact": default_exact, "history": []}
-        _save(ckpt, _clean(state))
-    while state["round"] < config.rounds and not state["stopped"]:
-        r = state["round"]
+        state = EventTuneCheckpoint(config=config.to_json(), round=0, stopped=False,
+                                    current=style_start(start, targets), best=BestSoFar(start, default_exact, -1),
+                                    default_exact=default_exact, history=())
+        _save(ckpt, state.to_json())
+    while state.round < config.rounds and not state.stopped:
+        r = state.round
         say(f"round {r + 1}/{config.rounds}: harvest + fit", r + 1, total)
-        fitted, record = _fit_round(config, state["current"], r, targets, map_tasks)
+        fitted, record = _fit_round(config, state.current, r, targets, map_tasks)
         say(f"round {r + 1}/{config.rounds}: exact runs", r + 1, total)
         tried = []
         for alpha in LINE_SEARCH:
-            params = _towards(state["current"], fitted, alpha)
+            params = _towards(state.current, fitted, alpha)
             candidate = event_metrics(setup, *_objects(params), targets, map_tasks)
-            accepted, why = accept(candidate, state["best"]["exact"], state["default_exact"], config.gain_noise_se)
+            accepted, why = accept(candidate, state.best.exact, state.default_exact, config.gain_noise_se)
             tried.append({"alpha": alpha, "exact_loss": candidate["exact_loss"],
                           "stride_rel_error": candidate["stride_rel_error"], "collisions": candidate["collisions"],
                           "decision": why})
             if accepted:
                 break
         record.update(round=r, alpha=alpha, accepted=accepted, decision=why, line_search=tried)
-        state["history"].append(record)
         if accepted:
-            state["best"] = {"params": params, "exact": candidate, "round": r}
-            state["current"] = params
-        else:
-            state["stopped"] = True
-        state["round"] = r + 1
-        state = _clean(state)
-        _save(ckpt, state)
-        if stop_after is not None and state["round"] >= stop_after:
+            state = dataclasses.replace(state, best=BestSoFar(params, candidate, r), current=params)
+        state = dataclasses.replace(state, round=r + 1, stopped=not accepted, history=(*state.history, record))
+        state = state.through_json()  # what a resume would read: NaN as None
+        _save(ckpt, state.to_json())
+        if stop_after is not None and state.round >= stop_after:
             return TuneResult(preset={}, summary={}, wall_s=time.perf_counter() - t0, finished=False)
     if not evaluate:
         return TuneResult(preset={}, summary={}, wall_s=time.perf_counter() - t0, finished=True)
     say("held-out runs", total - 1, total)
-    best = state["best"]
+    best = state.best
     holdout = config.holdout()
     held_default = event_metrics(holdout, *_objects(start), targets, map_tasks)
-    held_tuned = held_default if best["round"] < 0 else event_metrics(holdout, *_objects(best["params"]), targets,
+    held_tuned = held_default if best.round < 0 else event_metrics(holdout, *_objects(best.params), targets,
                                                                       map_tasks)
     gain, se, n = paired(held_default, held_tuned)
     refused = None
-    if best["round"] >= 0 and not gain > 0.0:
-        refused = (f"round {best['round']} refused on the held-out runs: paired loss gain {gain:.4g} "
+    if best.round >= 0 and not gain > 0.0:
+        refused = (f"round {best.round} refused on the held-out runs: paired loss gain {gain:.4g} "
                    f"(SE {se:.3g}, {n} runs) is not positive")
-        best = {"params": start, "exact": state["default_exact"], "round": -1}
+        best = BestSoFar(start, state.default_exact, -1)
         held_tuned, gain, se = held_default, 0.0, math.nan
     spearman = None
     if spearman_candidates > 0:
@@ -356,7 +402,7 @@ def _run(config, out, resume, progress, stop_after, write, map_tasks, t0, spearm
 
         say("proxy validation", total - 1, total)
         spearman = metric_change_spearman(config, targets, spearman_candidates, map_tasks)
-    weights, timing = _objects(best["params"])
+    weights, timing = _objects(best.params)
     from footfall import __version__
 
     summary = {
@@ -364,16 +410,16 @@ def _run(config, out, resume, progress, stop_after, write, map_tasks, t0, spearm
         "scenarios": list(config.scenarios),
         "targets": targets.to_json(),
         "heldout_scenarios": list(holdout.scenarios),
-        "loss_default": state["default_exact"]["exact_loss"], "loss_tuned": best["exact"]["exact_loss"],
+        "loss_default": state.default_exact["exact_loss"], "loss_tuned": best.exact["exact_loss"],
         "heldout_loss_default": held_default["exact_loss"], "heldout_loss_tuned": held_tuned["exact_loss"],
         "heldout_gain_se": None if not (se > 0.0) else gain / se,
         "heldout_runs": n,
         "heldout_stride_error_default": held_default["stride_rel_error"],
         "heldout_stride_error_tuned": held_tuned["stride_rel_error"],
         "heldout_collisions_default": held_default["collisions"], "heldout_collisions_tuned": held_tuned["collisions"],
-        "weights_max_rel_change": weights_max_rel_change(best["params"], start),
+        "weights_max_rel_change": weights_max_rel_change(best.params, start),
         "spearman_metric_change": None if spearman is None else spearman["spearman_min"],
-        "rounds_run": state["round"], "best_round": best["round"], "heldout_refused": refused,
+        "rounds_run": state.round, "best_round": best.round, "heldout_refused": refused,
     }
     provenance = {
         "tool": "footfall tune (terrain / style)", "footfall_version": __version__,
@@ -381,7 +427,7 @@ def _run(config, out, resume, progress, stop_after, write, map_tasks, t0, spearm
         "fit": {"method": "optimistix.LevenbergMarquardt on the weights' blocks (tuning._fit), weights only, "
                           "timing = the targets' stride law", "tau": config.tau},
         "objective": "tuning._events: runs spawned along the route, per-event metrics, paired run losses",
-        "rounds": state["history"],
+        "rounds": list(state.history),
         "heldout": {"default": _clean(held_default), "tuned": _clean(held_tuned)},
         "spearman": spearman,
         "summary": _clean(summary),
