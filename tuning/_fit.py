@@ -501,26 +501,26 @@ def fit(problem: FitProblem, n_steps: int = 20, solver=None):
 
     Examples
     --------
-    Two steps on a spider harvested with a too short stride law (coefficient 2.0, target 2.3):
-    the loss falls, and the commanded stride at the situations' speed lengthens:
+    A spider harvested with a too short stride law (coefficient 2.0, target 2.3). One step only
+    evaluates the start: ``history[0]`` is the loss there, and the parameters have not moved. (Two
+    steps bring the loss from 0.3781 to 0.0026 and lengthen the commanded stride: the fit's tests,
+    ``tests/test_tuning_fit.py``; each ``n_steps`` compiles its own program, about 7 s for two.)
 
     >>> from footfall.planner import GaitTiming
     >>> from footfall.tuning import harvest_situations, load_targets, make_problem, situations_from_harvest
+    >>> from footfall.tuning import fit, loss
+    >>> from footfall.tuning._fit import initial_params
     >>> harvest = harvest_situations(("flat",), ("spider",), frames=1, n_characters=1, max_situations=2,
     ...                              timing=GaitTiming(stride_coefficient=2.0))
     >>> situations = situations_from_harvest(harvest)
     >>> problem = make_problem(situations, harvest.creatures, load_targets(creatures=("spider",)), tau=0.01)
-    >>> from footfall.tuning import fit
-    >>> weights, timing, history = fit(problem, n_steps=2)
+    >>> weights, timing, history = fit(problem, n_steps=1)
     >>> weights.shape, timing.shape, history.shape
-    ((19,), (7,), (2,))
-    >>> round(float(history[0]), 4), bool(history[1] < 0.01 * history[0])
+    ((19,), (7,), (1,))
+    >>> round(float(history[0]), 4), bool(abs(history[0] - loss(initial_params(problem), problem)) < 1e-12)
     (0.3781, True)
-    >>> from footfall import planner
-    >>> v, h = float(situations.speed[0]), float(situations.leg_height[0])
-    >>> before = planner.stride_length(GaitTiming(stride_coefficient=2.0), v, h)
-    >>> bool(planner.stride_length(GaitTiming.from_array(timing), v, h) > before)
-    True
+    >>> GaitTiming.from_array(timing).stride_coefficient
+    2.0
     """
     if isinstance(n_steps, bool) or not isinstance(n_steps, int) or n_steps < 1:
         raise ValueError(f"n_steps: expected an integer >= 1, got {n_steps!r}")
