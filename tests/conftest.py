@@ -51,6 +51,7 @@ def kill_a_busy_worker():
 _SESSION_SEED = int(os.environ.setdefault("FOOTFALL_TEST_SEED", str(int.from_bytes(os.urandom(4), "little"))))
 
 
+@pytest.hookimpl(optionalhook=True)  # optional: a run with -p no:xdist has no such hook
 def pytest_xdist_auto_num_workers(config):
     """``-n auto``: one worker more than the cores (at most --maxprocesses). Many tests wait on
     processes of their own (the CLI, renderers, Dask workers, a headless browser): on 2 cores, 3
