@@ -40,15 +40,15 @@ def _arrays_digest(arrays: dict) -> dict:
     return out
 
 
-def _recorded(scenario_name: str, creature_name: str | None, characters: int, frames: int, seed: int, lod: str,
+def _recorded(scenario_name: str, creature_name: str, characters: int, frames: int, seed: int, lod: str,
               preset=None) -> dict:
     from footfall.reports._runs import recorded_run
     from footfall.scenarios import load_creature, load_scenario
     from footfall.scenarios._gait_choice import resolve_gait
 
     scenario = load_scenario(scenario_name)
-    creature = load_creature(creature_name) if creature_name else scenario.creature
-    gait, _, _ = resolve_gait(scenario if creature_name is None else None, creature)
+    creature = load_creature(creature_name)
+    gait, _, _ = resolve_gait(None, creature)  # the creature's default gait (not the scenario's)
     _, _, recorder = recorded_run(scenario, creature, gait, frames=frames, characters=characters, seed=seed,
                                   preset=preset, lod=lod)
     return _arrays_digest(recorder.arrays)

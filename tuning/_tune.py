@@ -488,12 +488,9 @@ class TuneCheckpoint:
     def from_json(cls, data: dict, path: Path) -> "TuneCheckpoint":
         """The checkpoint of a file's JSON; anything missing or malformed raises :class:`InputError`
         naming the file and the field."""
-        for key in ("config", "round", "stopped", "current", "current_exact", "best", "start_exact", "default_exact",
-                    "history"):
-            if key not in data:
-                raise InputError(path, key, "corrupt checkpoint: missing field")
-        if not isinstance(data["best"], dict):
-            raise InputError(path, "best", "corrupt checkpoint: expected an object")
+        checkpoint_fields(data, path, (("config", dict), ("round", int), ("stopped", bool), ("current", dict),
+                                       ("current_exact", None), ("best", dict), ("start_exact", None),
+                                       ("default_exact", None), ("history", list)))
         exact = {}
         for key, value in (("current_exact", data["current_exact"]), ("best.exact", data["best"].get("exact")),
                            ("start_exact", data["start_exact"]), ("default_exact", data["default_exact"])):
@@ -504,26 +501,40 @@ class TuneCheckpoint:
                 exact[key] = ExactMetrics.from_json(value)
             except (TypeError, ValueError) as e:
                 raise InputError(path, key, f"corrupt checkpoint: {e}") from None
-        try:
-            best = BestSoFar(params=data["best"]["params"], exact=exact["best.exact"], round=int(data["best"]["round"]))
-            for p in (data["current"], best.params):
-                _objects(p)
-        except (KeyError, TypeError, ValueError) as e:
-            raise InputError(path, "params", f"corrupt checkpoint: {e}") from None
-        for key, kind in (("round", int), ("stopped", bool), ("history", list)):
-            if not isinstance(data[key], kind):
-                raise InputError(path, key, f"corrupt checkpoint: expected {kind.__name__}")
+        if not isinstance(data["best"].get("round"), int):
+            raise InputError(path, "best", "corrupt checkpoint: expected params, exact and round")
+        checked_params(path, data["current"], data["best"].get("params"))
         return cls(config=data["config"], round=data["round"], stopped=data["stopped"],
-                   current=data["current"], current_exact=exact["current_exact"], best=best,
+                   current=data["current"], current_exact=exact["current_exact"],
+                   best=BestSoFar(data["best"]["params"], exact["best.exact"], data["best"]["round"]),
                    start_exact=exact["start_exact"], default_exact=exact["default_exact"],
                    history=tuple(data["history"]))
 
 
-def _save_checkpoint(path: Path, state: TuneCheckpoint) -> None:
-    write_text_atomic(path, json.dumps(state.to_json(), indent=1, allow_nan=False) + "\n")
+def checkpoint_fields(data: dict, path: Path, kinds) -> None:
+    """Each (field, type) of ``kinds`` is in a checkpoint's ``data`` and of that type (None: any);
+    else :class:`InputError` naming the file and the field. Both tunes' checkpoints read through it."""
+    for key, kind in kinds:
+        if key not in data:
+            raise InputError(path, key, "corrupt checkpoint: missing field")
+        if kind is not None and not isinstance(data[key], kind):
+            raise InputError(path, key, f"corrupt checkpoint: expected {kind.__name__}")
 
 
-def _load_checkpoint(path: Path, config: TuneConfig) -> TuneCheckpoint:
+def checked_params(path: Path, *params) -> None:
+    """Each of a checkpoint's parameter sets (``{"weights": [...], "timing": [...]}``) makes valid
+    weights and timing; else :class:`InputError` on the field ``params``."""
+    try:
+        for p in params:
+            _objects(p)
+    except (KeyError, TypeError, ValueError) as e:
+        raise InputError(path, "params", f"corrupt checkpoint: {e}") from None
+
+
+def read_checkpoint_json(path: Path, checkpoint_format: str, version: int, config_json: dict) -> dict:
+    """A checkpoint file's JSON, checked for its format, its version and the settings it was made
+    with (a resume with others is refused, naming them); else one :class:`InputError` line. Both
+    tunes' ``--resume`` read through it; their ``from_json`` checks the fields."""
     if not path.exists():
         raise InputError(path, "checkpoint", "no checkpoint to resume from (run without --resume first)")
     try:
@@ -532,14 +543,23 @@ def _load_checkpoint(path: Path, config: TuneConfig) -> TuneCheckpoint:
         raise InputError(path, "checkpoint", f"cannot read: {e}") from None
     except json.JSONDecodeError as e:
         raise InputError(path, "checkpoint", f"corrupt (not JSON: {e.msg} at line {e.lineno})") from None
-    if not isinstance(data, dict) or data.get("format") != CHECKPOINT_FORMAT:
-        raise InputError(path, "format", f"corrupt: expected a {CHECKPOINT_FORMAT} file")
-    if data.get("version") != CHECKPOINT_VERSION:
-        raise InputError(path, "version", f"expected {CHECKPOINT_VERSION}, got {data.get('version')!r}")
-    if "config" in data and data["config"] != config.to_json():
+    if not isinstance(data, dict) or data.get("format") != checkpoint_format:
+        raise InputError(path, "format", f"corrupt: expected a {checkpoint_format} file")
+    if data.get("version") != version:
+        raise InputError(path, "version", f"expected {version}, got {data.get('version')!r}")
+    if "config" in data and data["config"] != config_json:
         theirs = data["config"] if isinstance(data["config"], dict) else {}
-        diff = sorted(k for k in config.to_json() if theirs.get(k) != config.to_json()[k])
+        diff = sorted(k for k, v in config_json.items() if theirs.get(k) != v)
         raise InputError(path, "config", f"the checkpoint was made with other settings ({', '.join(diff)})")
+    return data
+
+
+def _save_checkpoint(path: Path, state: TuneCheckpoint) -> None:
+    write_text_atomic(path, json.dumps(state.to_json(), indent=1, allow_nan=False) + "\n")
+
+
+def _load_checkpoint(path: Path, config: TuneConfig) -> TuneCheckpoint:
+    data = read_checkpoint_json(path, CHECKPOINT_FORMAT, CHECKPOINT_VERSION, config.to_json())
     return TuneCheckpoint.from_json(data, path)
 
 

@@ -42,7 +42,8 @@ from footfall._errors import InputError
 from footfall.tuning._events import (EVENT_FRAMES, SPAWN_FRACTIONS, EventSetup, collisions_rise, event_metrics, paired,
                             spawn_variant)
 from footfall.tuning._tune import (LINE_SEARCH, BestSoFar, TuneResult, _bucket, _floats, _objects, _pad_problem, _towards,
-                          check_creature, check_output, checkpoint_path)
+                          check_creature, check_output, checked_params, checkpoint_fields, checkpoint_path,
+                          read_checkpoint_json)
 
 CHECKPOINT_FORMAT = "footfall-tune-events-checkpoint"
 CHECKPOINT_VERSION = 1
@@ -267,22 +268,13 @@ class EventTuneCheckpoint:
     def from_json(cls, data: dict, path: Path) -> "EventTuneCheckpoint":
         """The checkpoint of a file's JSON; anything missing or of the wrong kind raises
         :class:`InputError` naming the file and the field."""
-        kinds = (("config", dict), ("round", int), ("stopped", bool), ("current", dict), ("best", dict),
-                 ("default_exact", dict), ("history", list))
-        for key, kind in kinds:
-            if key not in data:
-                raise InputError(path, key, "corrupt checkpoint: missing field")
-            if not isinstance(data[key], kind):
-                raise InputError(path, key, f"corrupt checkpoint: expected {kind.__name__}")
+        checkpoint_fields(data, path, (("config", dict), ("round", int), ("stopped", bool), ("current", dict),
+                                       ("best", dict), ("default_exact", dict), ("history", list)))
         best = data["best"]
         if not (isinstance(best.get("params"), dict) and isinstance(best.get("exact"), dict)
                 and isinstance(best.get("round"), int)):
             raise InputError(path, "best", "corrupt checkpoint: expected params, exact and round")
-        try:
-            for p in (data["current"], best["params"]):
-                _objects(p)
-        except (KeyError, TypeError, ValueError) as e:
-            raise InputError(path, "params", f"corrupt checkpoint: {e}") from None
+        checked_params(path, data["current"], best["params"])
         return cls(config=data["config"], round=data["round"], stopped=data["stopped"], current=data["current"],
                    best=BestSoFar(best["params"], best["exact"], best["round"]), default_exact=data["default_exact"],
                    history=tuple(data["history"]))
@@ -293,21 +285,8 @@ class EventTuneCheckpoint:
 
 
 def _load(path: Path, config: EventTuneConfig) -> EventTuneCheckpoint:
-    if not path.exists():
-        raise InputError(path, "checkpoint", "no checkpoint to resume from (run without --resume first)")
-    try:
-        state = json.loads(path.read_text())
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
-        raise InputError(path, "checkpoint", f"cannot read: {e}") from None
-    if not isinstance(state, dict) or state.get("format") != CHECKPOINT_FORMAT:
-        raise InputError(path, "format", f"corrupt: expected a {CHECKPOINT_FORMAT} file")
-    if state.get("version") != CHECKPOINT_VERSION:
-        raise InputError(path, "version", f"expected {CHECKPOINT_VERSION}, got {state.get('version')!r}")
-    if state.get("config") != config.to_json():
-        theirs = state.get("config") if isinstance(state.get("config"), dict) else {}
-        diff = sorted(k for k, v in config.to_json().items() if theirs.get(k) != v)
-        raise InputError(path, "config", f"the checkpoint was made with other settings ({', '.join(diff)})")
-    return EventTuneCheckpoint.from_json(state, path)
+    data = read_checkpoint_json(path, CHECKPOINT_FORMAT, CHECKPOINT_VERSION, config.to_json())
+    return EventTuneCheckpoint.from_json(data, path)
 
 
 def weights_max_rel_change(tuned: dict, default: dict) -> float:
