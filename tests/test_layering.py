@@ -45,21 +45,25 @@ def _imports(path: Path):
                 yield node.lineno, alias.name
 
 
-def test_each_package_imports_only_its_floor_and_the_ones_below():
+def _wrong_imports(path: Path, floor: int) -> list[tuple[int, str, str]]:
+    """(line, module, why) of each import in ``path`` that a package on ``floor`` may not make: a
+    top-level name of the old layout, or a package on a higher floor."""
     wrong = []
-    for folder, (_, floor) in FLOORS.items():
-        for path in sorted((ROOT / folder).glob("*.py")):
-            for line, module in _imports(path):
-                top = module.split(".")[0]
-                if top in OLD_TOP_LEVEL:
-                    wrong.append(f"{folder}/{path.name}:{line}: imports {module} (a top-level name; footfall.{module})")
-                    continue
-                target = _package_of(module)
-                if target is None:
-                    continue  # a third-party package
-                if FLOORS[target][1] > floor:
-                    wrong.append(f"{folder}/{path.name}:{line}: imports {module} (floor {FLOORS[target][1]} "
-                                 f"above {folder}'s {floor})")
+    for line, module in _imports(path):
+        if module.split(".")[0] in OLD_TOP_LEVEL:
+            wrong.append((line, module, f"a top-level name; footfall.{module}"))
+            continue
+        target = _package_of(module)  # None: a third-party package
+        if target is not None and FLOORS[target][1] > floor:
+            wrong.append((line, module, f"floor {FLOORS[target][1]} above {floor}"))
+    return wrong
+
+
+def test_each_package_imports_only_its_floor_and_the_ones_below():
+    wrong = [f"{folder}/{path.name}:{line}: imports {module} ({why})"
+             for folder, (_, floor) in FLOORS.items()
+             for path in sorted((ROOT / folder).glob("*.py"))
+             for line, module, why in _wrong_imports(path, floor)]
     assert not wrong, "\n".join(wrong)
 
 
@@ -71,10 +75,9 @@ def test_the_floor_rule_sees_an_upward_import(tmp_path):
     good = tmp_path / "good.py"
     good.write_text("from footfall._errors import InputError\nfrom footfall.planner import layout\nimport numpy\n")
     floor = FLOORS["planner"][1]
-    flagged = [m for _, m in _imports(bad)
-               if m.split(".")[0] in OLD_TOP_LEVEL or (_package_of(m) and FLOORS[_package_of(m)][1] > floor)]
-    assert flagged == ["footfall.cli", "footfall.cli.app", "planner._crowd", "footfall.reports"]
-    assert [m for _, m in _imports(good) if _package_of(m) and FLOORS[_package_of(m)][1] > floor] == []
+    assert [m for _, m, _ in _wrong_imports(bad, floor)] == ["footfall.cli", "footfall.cli.app", "planner._crowd",
+                                                             "footfall.reports"]
+    assert _wrong_imports(good, floor) == []
 
 
 def test_only_the_namespace_is_importable_outside_the_repository(tmp_path):
