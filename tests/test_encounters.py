@@ -342,6 +342,36 @@ def test_between_two_crates_lanes_the_way_out_leads_away_from_both(tmp_path):
     np.testing.assert_allclose(direction[0], [0.0, -1.0], atol=1e-12)
 
 
+@pytest.mark.parametrize("gap, expected", [(0.05, [0.0, 1.0]), (1.0, [0.0, -1.0])])
+def test_a_lane_exit_walled_by_a_static_crate_takes_the_other_side(tmp_path, gap, expected):
+    # The first encounter's crate (0.5 m, from (1, 0) at -0.2 m/s) and a spider at (0, -0.1), its way +x:
+    # the nearer side is -z. A static forbidden crate (0.4 m) stands beside it on that side, its face
+    # ``gap`` beyond the spider's avoid radius r. Walking -z at 0.3 m/s it comes within r of that face
+    # after gap / 0.3 s: 0.17 s with gap 0.05, inside ORCA's 1.5 s box horizon, so ORCA would refuse
+    # that way (the spider stood still on the lane's edge until the crate came: crates-moving, seed 11).
+    # The other side, +z, leaves the lane (0.63 m, from -0.1) in 2.43 s and meets the crate at 1.85 s
+    # (its centre within 0.63 m along); the walled side scores 0.2 s (the first 0.1 s step within r).
+    # So +z. With the face 1.0 m further (3.3 s), the wall is ORCA's business later: -z, as without it.
+    from footfall.planner._crowd import _box_velocities, _boxes_now, _lane_exit
+
+    spider = load_creature("spider")
+    moving = CRATE.format(centre=[1.0, 0.0], width=0.5, motion='motion = { kind = "velocity", velocity = [-0.2, 0.0] }')
+
+    def world(crates):
+        path = tmp_path / "walled.toml"
+        path.write_text(WORLD.format(name="walled", crate=crates, start=[-4.0, 3.0], goal=[4.0, 3.0], speed=0.3))
+        return init_crowd(load_scenario(str(path)), spider, gait_schedule(spider), n_characters=1, seed=0)
+
+    r = world(moving)[0].avoid_radius  # the spider's rest radius: 0.34 m
+    model, state = world(moving + CRATE.format(centre=[0.0, -0.1 - (r + gap) - 0.2], width=0.4, motion=""))
+    assert model.avoid_radius == r == pytest.approx(0.34, abs=0.005)
+    state.pelvis[0, [0, 2]] = [0.0, -0.1]
+    boxes = _boxes_now(model, state.t)
+    direction, in_lane = _lane_exit(model, state, np.array([[1.0, 0.0]]), boxes, _box_velocities(model, state.t, boxes[0]))
+    assert in_lane[0]
+    np.testing.assert_allclose(direction[0], expected, atol=1e-12)
+
+
 def test_a_foot_a_wide_crate_leaves_no_footprint_is_tucked_out_of_its_way(tmp_path, monkeypatch):
     # A spider stands at its goal (0, 0) facing +x. A 0.6 m crate slides +x at 0.2 m/s along z = 0.45:
     # it covers z 0.15..0.75, the left feet's spots (about 0.3 m to the left) and their candidate discs
