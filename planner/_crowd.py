@@ -1181,7 +1181,10 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, fre
     far |= stops_turn
     # Such a foot of a character escaping a moving box's lane that finds no footprint tucks (stage_plan),
     # as a threatened one does: held, it kept the body from turning out of the lane until the box came.
-    state.blocks_escape = stops_turn & state.escaping[:, None]
+    # So does a foot its leg cannot follow: with the box's path covering every spot within its reach, a
+    # spider's three right legs planned no footprint for 25 frames, holding the body in the lane until
+    # the crate ran over them (mixed, 8 spiders, seed 28: 161 foot-frames in the crate).
+    state.blocks_escape = (stops_turn | cannot_follow) & state.escaping[:, None]
     # So does a stance leg the turn asked would carry across another (uncrossing_turn holds the turn).
     far |= turn_crossed_legs(model, state, state.turn_wanted)
     # A stance foot the body turned across another leg steps (its own side again).

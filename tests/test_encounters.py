@@ -488,57 +488,85 @@ def test_a_tuck_point_inside_a_box_moves_in_to_the_first_clear_one(tmp_path):
     np.testing.assert_allclose(tuck_points(model, state, chars, legs, hips), at(TUCK_REACHES[0]), atol=1e-12)
 
 
-def test_a_stance_foot_that_stops_an_escape_and_finds_no_footprint_is_tucked(tmp_path, monkeypatch):
-    # A spider standing still, facing +x, its goal ahead, is told by the steering that it is in a
-    # moving box's lane and must leave it to its left (+z, a turn of +pi/2). Its left front foot stands on the
-    # midline margin (STANCE_SIDE_MARGIN of its hip's offset from the midline): a left turn would carry
-    # it across, so it bounds the turn to 0 and must step. No footprint is found anywhere (every plan
-    # fails). Escaping, the foot is tucked (it leaves the ground, the turn is free of it); not
-    # escaping, it stays down (a hold) and keeps the turn at 0.
+def _escape_step_without_footprints(tmp_path, monkeypatch, escaping, prepare):
+    """A spider standing still with every foot down, facing +x, its goal ahead; ``prepare(model, state,
+    hips)`` sets up one left front foot and returns its leg. Then one frame in which the steering says
+    it is (``escaping``) or is not in a moving box's lane, to leave to its left (+z), and every plan
+    fails. Returns (state, leg, heading before the frame)."""
     import footfall.planner._crowd as crowd
-    from footfall.planner._crowd import STANCE_SIDE_MARGIN, hips_world, leg_turn_bounds
+    from footfall.planner._crowd import hips_world
 
-    def run(escaping):
-        model, state = _world(tmp_path, "escape", crate_centre=(5.0, 5.0), crate_width=0.2, start=(0.0, 0.0),
-                              goal=(0.0, 0.0))
-        for _ in range(30):  # every foot down
-            step(model, state)
-        state.heading[:] = 0.0
-        state.route[0] = [4.0, 0.0]  # not at its goal: a character there stops turning
-        hips = hips_world(model, state)
-        leg = int(np.flatnonzero((model.hips_body[:, 0] > 0) & (model.hips_body[:, 2] > 0))[0])
-        state.in_stance[0] = True
-        state.wants_swing[0] = False
+    model, state = _world(tmp_path, "escape", crate_centre=(5.0, 5.0), crate_width=0.2, start=(0.0, 0.0),
+                          goal=(0.0, 0.0))
+    for _ in range(30):  # every foot down
+        step(model, state)
+    state.heading[:] = 0.0
+    state.route[0] = [4.0, 0.0]  # not at its goal: a character there stops turning
+    state.in_stance[0] = True
+    state.wants_swing[0] = False
+    leg = prepare(model, state, hips_world(model, state))
+
+    def lane_exit(model, state, direction, boxes, box_velocity):
+        return np.array([[0.0, 1.0]]), np.array([escaping])
+
+    def no_footprint(*args, **kwargs):
+        out, groups = original(*args, **kwargs)
+        out.valid[:] = False
+        return out, groups
+
+    original = crowd._plan_groups
+    monkeypatch.setattr(crowd, "_lane_exit", lane_exit)
+    monkeypatch.setattr(crowd, "_plan_groups", no_footprint)
+    heading = float(state.heading[0])
+    step(model, state)
+    monkeypatch.undo()
+    return state, leg, heading
+
+
+def _left_front_leg(model):
+    return int(np.flatnonzero((model.hips_body[:, 0] > 0) & (model.hips_body[:, 2] > 0))[0])
+
+
+def test_a_stance_foot_that_stops_an_escape_and_finds_no_footprint_is_tucked(tmp_path, monkeypatch):
+    # Its left front foot stands on the midline margin (STANCE_SIDE_MARGIN of its hip's offset from
+    # the midline): a left turn would carry it across, so it bounds the turn to 0 and must step. No
+    # footprint is found anywhere (every plan fails). Escaping, the foot is tucked (it leaves the
+    # ground, the turn is free of it); not escaping, it stays down (a hold) and keeps the turn at 0.
+    from footfall.planner._crowd import STANCE_SIDE_MARGIN, leg_turn_bounds
+
+    def on_the_margin(model, state, hips):
+        leg = _left_front_leg(model)
         state.feet[0, leg, 2] = state.pelvis[0, 2] + STANCE_SIDE_MARGIN * model.hips_body[leg, 2]
         state.feet[0, leg, 0] = max(state.feet[0, leg, 0], hips[0, leg, 0] + 0.05)
         assert leg_turn_bounds(model, state)[0, leg] == 0.0  # premise: no room for a left turn
+        return leg
 
-        def lane_exit(model, state, direction, boxes, box_velocity):
-            return np.array([[0.0, 1.0]]), np.array([escaping])
-
-        def no_footprint(*args, **kwargs):
-            out, groups = original(*args, **kwargs)
-            out.valid[:] = False
-            return out, groups
-
-        original = crowd._plan_groups
-        monkeypatch.setattr(crowd, "_lane_exit", lane_exit)
-        monkeypatch.setattr(crowd, "_plan_groups", no_footprint)
-        heading = float(state.heading[0])
-        step(model, state)
-        monkeypatch.undo()
-        return state, leg, heading
-
-    state, leg, _ = run(escaping=True)
+    state, leg, _ = _escape_step_without_footprints(tmp_path, monkeypatch, True, on_the_margin)
     assert state.tucked[0, leg] and not state.in_stance[0, leg]
     assert state.blocks_escape[0, leg]
     # Only feet that stop the escape (bound it to 0, or below half the turn asked of a body standing).
     assert not (state.tucked[0] & ~state.blocks_escape[0]).any()
-    state, leg, heading = run(escaping=False)
+    state, leg, heading = _escape_step_without_footprints(tmp_path, monkeypatch, False, on_the_margin)
     assert state.in_stance[0, leg] and not state.tucked[0].any()
     assert state.heading[0] == heading
 
 
+def test_a_foot_its_leg_cannot_follow_that_finds_no_footprint_is_tucked_when_escaping(tmp_path, monkeypatch):
+    # Its left front leg lost its foot in the last frame (``unfollowed``: the pose was taken back), so
+    # the foot must step, and no footprint is found. Escaping a moving box's lane, the foot is tucked:
+    # held down it would hold the body in the lane (mixed, 8 spiders, seed 28: a crate's path covered
+    # every spot three right legs could reach; they planned no footprint for 25 frames and the crate
+    # ran over them). Not escaping, it stays down (a hold), as before.
+    def lost(model, state, hips):
+        leg = _left_front_leg(model)
+        state.unfollowed[0, leg] = True
+        return leg
+
+    state, leg, _ = _escape_step_without_footprints(tmp_path, monkeypatch, True, lost)
+    assert state.tucked[0, leg] and not state.in_stance[0, leg] and state.blocks_escape[0, leg]
+    assert not (state.tucked[0] & ~state.blocks_escape[0]).any()
+    state, leg, _ = _escape_step_without_footprints(tmp_path, monkeypatch, False, lost)
+    assert state.in_stance[0, leg] and not state.tucked[0].any() and state.counters["holds"] > 0
 
 
 @pytest.mark.parametrize("neighbour", [False, True])
