@@ -344,6 +344,8 @@ class Oracle:
                 gap = min([min(point_segment_distance(tx, tz, a, b, fx, fz),
                                point_segment_distance(fx, fz, hip_x, hip_z, tx, tz)) for a, b, fx, fz in legs],
                           default=math.inf)
+                if gap < 0.5 * radius:
+                    continue  # half a foot's room from every other leg, both ways (LEG_CLEARANCE)
                 if other_leg_cell:
                     # ... and with a foot's room from every leg and foot, both ways.
                     if gap < radius or any(math.hypot(tx - fx, tz - fz) <= radius for _, _, fx, fz in legs):
