@@ -719,10 +719,18 @@ def _static_contact(model: CrowdModel, state: CrowdState, rows, ways, boxes, sta
     (:data:`AVOID_BOX_HORIZON`: a way ORCA refuses for that box); :data:`LANE_HORIZON` where it meets
     none by then (ORCA lets it walk that way, and steers round the box later). A box already that
     near counts where the way goes nearer to it."""
-    centres, sizes, yaws = boxes[0][static][:, [0, 2]], 0.5 * boxes[1][static][:, [0, 2]], boxes[2][static]
     radius = model.avoid_radius
     steps = np.arange(0.0, AVOID_BOX_HORIZON + 1e-9, STATIC_CONTACT_STEP)  # (T,)
     xz = state.pelvis[rows][:, [0, 2]]
+    # Only the boxes some of these characters can reach within the horizon (the result is the same;
+    # a crowd in a wide world has hundreds of crates and the arrays below grow with each).
+    half = 0.5 * boxes[1][static][:, [0, 2]]
+    reach = state.desired_speed[rows].max() * steps[-1] + radius + np.hypot(half[:, 0], half[:, 1])
+    gap = np.hypot(*(xz[:, None, :] - boxes[0][static][None, :, [0, 2]]).transpose(2, 0, 1)).min(axis=0)
+    static = static[gap <= reach]
+    if not static.size:
+        return np.full(ways.shape[:2], LANE_HORIZON)
+    centres, sizes, yaws = boxes[0][static][:, [0, 2]], 0.5 * boxes[1][static][:, [0, 2]], boxes[2][static]
     path = (xz[:, None, None, :]
             + state.desired_speed[rows][:, None, None, None] * steps[None, None, :, None] * ways[:, :, None, :])
     rel = path[..., None, :] - centres  # (R, K, T, B, 2)
