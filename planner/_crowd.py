@@ -682,7 +682,7 @@ def _lane_exit(model: CrowdModel, state: CrowdState, direction: np.ndarray, boxe
     # ORCA, refusing that way, held it still on the lane's edge until the crate ran over its feet
     # (crates-moving, 12 spiders, seed 11, frames 470-590). Such a character chooses its way out as a
     # character between two lanes does.
-    static = np.flatnonzero(np.asarray(boxes[3]) & ~boxes[4])
+    static = np.flatnonzero(boxes[3] & ~boxes[4])  # forbidden and not moving (the masks of _boxes_now)
     walled = np.zeros(n, np.bool_)
     if static.size:
         walled[in_lane] = _static_contact(model, state, np.flatnonzero(in_lane), direction[in_lane][:, None],
@@ -724,13 +724,13 @@ def _static_contact(model: CrowdModel, state: CrowdState, rows, ways, boxes, sta
     xz = state.pelvis[rows][:, [0, 2]]
     # Only the boxes some of these characters can reach within the horizon (the result is the same;
     # a crowd in a wide world has hundreds of crates and the arrays below grow with each).
-    half = 0.5 * boxes[1][static][:, [0, 2]]
-    reach = state.desired_speed[rows].max() * steps[-1] + radius + np.hypot(half[:, 0], half[:, 1])
-    gap = np.hypot(*(xz[:, None, :] - boxes[0][static][None, :, [0, 2]]).transpose(2, 0, 1)).min(axis=0)
-    static = static[gap <= reach]
-    if not static.size:
-        return np.full(ways.shape[:2], LANE_HORIZON)
     centres, sizes, yaws = boxes[0][static][:, [0, 2]], 0.5 * boxes[1][static][:, [0, 2]], boxes[2][static]
+    reach = state.desired_speed[rows].max() * steps[-1] + radius + np.hypot(sizes[:, 0], sizes[:, 1])
+    gap = np.hypot(*(xz[:, None, :] - centres[None]).transpose(2, 0, 1)).min(axis=0)
+    keep = gap <= reach
+    if not keep.any():
+        return np.full(ways.shape[:2], LANE_HORIZON)
+    centres, sizes, yaws = centres[keep], sizes[keep], yaws[keep]
     path = (xz[:, None, None, :]
             + state.desired_speed[rows][:, None, None, None] * steps[None, None, :, None] * ways[:, :, None, :])
     rel = path[..., None, :] - centres  # (R, K, T, B, 2)
