@@ -11,7 +11,9 @@ The command line, the benchmarks' mains and the tests call :func:`configure_numb
 anything compiles; importing ``footfall.planner`` changes no environment variable. A program that
 imports the planner itself calls it first (or lives with numba's default: a cache beside each source
 file, invalidated by that file's own changes only). Processes started afterwards (Dask workers, the
-renderer) inherit the folder through the environment.
+renderer) inherit the folder through the environment. Importing the planner with ``NUMBA_CACHE_DIR``
+set to any other folder warns (:func:`warn_if_foreign_cache`): a kernel cached there from other
+sources would run their code.
 """
 
 from __future__ import annotations
@@ -59,6 +61,40 @@ def kernel_sources_digest(folder: Path) -> str:
     return digest.hexdigest()[:16]
 
 
+def _planner_folder() -> Path:
+    spec = importlib.util.find_spec("footfall.planner")  # its folder, without running its __init__
+    return Path(spec.submodule_search_locations[0])
+
+
+def warn_if_foreign_cache() -> bool:
+    """Warn (``RuntimeWarning``) when numba caches in a folder set by hand that is not named after these
+    kernel sources; return whether it warned. ``footfall.planner`` calls it on import.
+
+    numba reuses a kernel cached in that folder as long as the kernel's own file is unchanged, with the
+    code of whatever kernels it called *then*: after an edit or an upgrade of another kernel file, a
+    run silently computes with the old code (a script importing the planner before
+    :func:`configure_numba_cache` counted 38 leg crossings where the command line counted 2). No folder
+    set by hand: numba's default, beside the sources, and no warning.
+
+    Returns
+    -------
+    bool
+        True if it warned.
+    """
+    if "numba" in sys.modules:
+        import numba.core.config
+
+        folder = numba.core.config.CACHE_DIR or os.environ.get("NUMBA_CACHE_DIR", "")
+    else:
+        folder = os.environ.get("NUMBA_CACHE_DIR", "")
+    if not folder or Path(folder).name == kernel_sources_digest(_planner_folder()):
+        return False
+    warnings.warn(f"footfall.planner: NUMBA_CACHE_DIR={folder} is not named after these kernel sources, and "
+                  "kernels cached there from other sources would run their old code: call "
+                  "footfall.configure_numba_cache() before importing footfall.planner", RuntimeWarning, stacklevel=3)
+    return True
+
+
 def configure_numba_cache() -> Path:
     """Point numba's cache at ``ROOT/<digest of the kernel sources>`` and return that folder.
 
@@ -85,8 +121,7 @@ def configure_numba_cache() -> Path:
     >>> configure_numba_cache() == folder  # again: the same folder, not one nested inside it
     True
     """
-    spec = importlib.util.find_spec("footfall.planner")  # its folder, without running its __init__
-    folder = Path(spec.submodule_search_locations[0])
+    folder = _planner_folder()
     root = Path(os.environ.get("FOOTFALL_NUMBA_CACHE_ROOT") or os.environ.get("NUMBA_CACHE_DIR")
                 or Path.home() / ".cache" / "footfall" / "numba")
     os.environ.setdefault("FOOTFALL_NUMBA_CACHE_ROOT", str(root))

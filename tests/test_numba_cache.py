@@ -50,3 +50,18 @@ def test_configuring_after_the_planner_was_imported_warns(tmp_path):
     proc = _run(code, dict(CLEAN, NUMBA_CACHE_DIR=str(tmp_path)))
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.startswith("1 configure_numba_cache: footfall.planner was imported before")
+
+
+def test_importing_the_planner_with_a_cache_folder_set_by_hand_warns(tmp_path):
+    # numba reuses a kernel cached there while the kernel's own file is unchanged, with the code its callees
+    # in other files had then: a script that imported the planner first counted 38 leg crossings where the
+    # command line counted 2. The folder configure_numba_cache names after the sources is quiet.
+    code = "import footfall.planner"
+    foreign = _run(code, dict(CLEAN, NUMBA_CACHE_DIR=str(tmp_path), PYTHONWARNINGS="error::RuntimeWarning"))
+    assert foreign.returncode != 0
+    assert "NUMBA_CACHE_DIR=" in foreign.stderr and "configure_numba_cache()" in foreign.stderr
+    named = _run("from footfall import configure_numba_cache; configure_numba_cache(); " + code,
+                 dict(CLEAN, NUMBA_CACHE_DIR=str(tmp_path), PYTHONWARNINGS="error::RuntimeWarning"))
+    assert named.returncode == 0, named.stderr[-2000:]
+    default = _run(code, dict(CLEAN, PYTHONWARNINGS="error::RuntimeWarning"))  # numba's own default: quiet
+    assert default.returncode == 0, default.stderr[-2000:]
