@@ -51,6 +51,7 @@ from footfall.planner._kernels_foot import (
     CNT_EXPANDED,
     CNT_SLICES,
     CNT_WAVEFRONTS,
+    ESCAPE_RISE,
     JERK_SAMPLES,
     MAX_DENSE,
     N_COUNTERS,
@@ -62,6 +63,8 @@ from footfall.planner._kernels_foot import (
     RAW_LENGTH,
     couple_metrics_2d,
     couple_metrics_3d,
+    drawn_heights,
+    elevate_3d,
     footprint_candidates,
     prepare_foot,
     resample_by_arclength,
@@ -195,6 +198,9 @@ def plan_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, 
     one = np.empty(1, dtype=np.int64)
     stop = np.empty(max(n_cand, 1), dtype=np.int64)
     rows, cols, dense, dense_p, poly = path_workspace(hp, wp)
+    g_free = np.empty(MAX_DENSE, dtype=np.float64)
+    dense_drawn = np.empty((MAX_DENSE, 3), dtype=np.float64)
+    poly_drawn = np.empty((MAX_DENSE, 3), dtype=np.float64)
     best_poly = np.empty((MAX_DENSE, 3), dtype=np.float64)
     jerk_work = np.empty((JERK_SAMPLES, 3), dtype=np.float64)
     terms = np.empty(N_TERMS, dtype=np.float64)
@@ -243,8 +249,8 @@ def plan_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, 
             if not math.isfinite(dist[s, tp]):
                 continue
             nd, len2, curv, clear, climb2 = couple_metrics_2d(
-                parent[s], passable[s], dt[s], elev_dil, source_p, tp, source_x, source_y, source_z, tx, target_y, tz,
-                step_height, r0, c0, hp, wp, origin_x, origin_z, cell, dense, dense_p, rows, cols)
+                parent[s], passable[s], dt[s], elev_dil, code, source_p, tp, source_x, source_y, source_z, tx, target_y,
+                tz, step_height, r0, c0, hp, wp, origin_x, origin_z, cell, dense, dense_p, g_free, rows, cols)
             if nd < 2:
                 continue
             counters[CNT_COUPLES_2D] += 1
@@ -277,10 +283,15 @@ def plan_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, 
                 best_raw[RAW_CLEARANCE] = clear
                 best_raw[RAW_CLIMB] = climb3
                 best_raw[RAW_JERK] = jerk
+                drawn = poly
+                if drawn_heights(dense, g_free, nd, source_y + ESCAPE_RISE * step_height, dense_drawn):
+                    elevate_3d(dense_drawn, nd, len2, source_y, target_y, step_height, cfg[C_OBST_MARGIN], cell,
+                               poly_drawn)
+                    drawn = poly_drawn
                 for i in range(nd):
-                    best_poly[i, 0] = poly[i, 0]
-                    best_poly[i, 1] = poly[i, 1]
-                    best_poly[i, 2] = poly[i, 2]
+                    best_poly[i, 0] = drawn[i, 0]
+                    best_poly[i, 1] = drawn[i, 1]
+                    best_poly[i, 2] = drawn[i, 2]
             first_found = True
             if mode != MODE_BRUTE_FORCE and couples_after_first >= 0 and after_first >= couples_after_first:
                 done = True
@@ -360,6 +371,7 @@ def harvest_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offset
     parent = np.empty(n, dtype=np.int64)
     stop = np.empty(max(n_cand, 1), dtype=np.int64)
     rows, cols, dense, dense_p, poly = path_workspace(hp, wp)
+    g_free = np.empty(MAX_DENSE, dtype=np.float64)
     jerk_work = np.empty((JERK_SAMPLES, 3), dtype=np.float64)
     terms = np.empty(N_TERMS, dtype=np.float64)
     for s in range(n_slices):
@@ -379,8 +391,9 @@ def harvest_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offset
                 continue
             target_y = elev_dil[tp]
             nd, len2, curv, clear, climb2 = couple_metrics_2d(
-                parent, passable, dt, elev_dil, source_p, tp, source_x, source_y, source_z, cand_xz[k, 0], target_y,
-                cand_xz[k, 1], step_height, r0, c0, hp, wp, origin_x, origin_z, cell, dense, dense_p, rows, cols)
+                parent, passable, dt, elev_dil, code, source_p, tp, source_x, source_y, source_z, cand_xz[k, 0],
+                target_y, cand_xz[k, 1], step_height, r0, c0, hp, wp, origin_x, origin_z, cell, dense, dense_p, g_free,
+                rows, cols)
             if nd < 2:
                 continue
             len3, climb3, jerk = couple_metrics_3d(dense, nd, len2, source_y, target_y, step_height,

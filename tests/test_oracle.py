@@ -1187,3 +1187,42 @@ def test_hand_goodness_formulas():
     np.testing.assert_allclose(terms, [0.8, 0.75, 0.75, 0.4, 1.0, 2 / 3, 2 / 3, 0.5, 2 / 3, 0.25], rtol=0,
                                atol=HAND_TOL)
     assert weighted_mean(w, terms, 0, 10) == pytest.approx(0.6951388888888889, abs=HAND_TOL)
+
+
+# ----------------------------------------------------------------------------- a foot never climbs a forbidden box
+def test_drawn_heights_keep_a_swing_under_a_ceiling_over_forbidden_cells_only():
+    # Per sample: G, but no more than the ceiling where G came from a forbidden box's cells (G over the
+    # others, g_free, is kept whatever the ceiling).
+    from footfall.planner._kernels_foot import drawn_heights
+
+    dense = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.4], [2.0, 0.0, 0.4], [3.0, 0.0, 0.3]])
+    g_free = np.array([0.0, -math.inf, 0.25, 0.3])
+    out = np.empty_like(dense)
+    assert drawn_heights(dense, g_free, 4, 0.1, out)
+    assert out.tolist() == [[0.0, 0.0, 0.0], [1.0, 0.0, 0.1], [2.0, 0.0, 0.25], [3.0, 0.0, 0.3]]
+    assert not drawn_heights(dense, dense[:, 2].copy(), 4, 0.1, out)  # nothing from a forbidden box
+    assert out.tolist() == dense.tolist()
+
+
+@pytest.mark.parametrize("box_height", [0.25, 0.4])
+def test_a_foot_stepping_away_from_a_tall_forbidden_box_beside_it_is_scored_climbing_it_and_drawn_low(box_height):
+    # 14 x 14 cells of 7 cm, flat; a forbidden box of height box_height fills column 6 (x in [0.42, 0.49]).
+    # The foot stands at the centre of (7, 5) = (0.385, 0.525): its 3 x 3 stencil touches column 6, so its
+    # cell is a size increase one and the swing leaves through it (the foot of a box that moved next to it,
+    # or where one is heading), to (0.175, 0.525), 3 cells away. The couple is scored climbing the box's
+    # dilated top (climb = top + 1 cm margin - (0 + 5 cm step height)), which sends an escape far from
+    # the box; the swing was drawn over it too (0.26, 0.41 m). Now it is drawn no higher than two step
+    # heights + the margin: the box is forbidden at any height, and its top is no way out.
+    n, cell, step, margin = 14, 0.07, 0.05, PlannerConfig().obstacle_margin_m
+    forbidden = np.zeros((n, n), np.uint8)
+    forbidden[:, 6] = 1
+    elevation = np.zeros((n, n))
+    elevation[:, 6] = box_height
+    maps = LocalMaps(GridFrame(0.0, 0.0, cell, n, n), elevation, np.zeros((n, n)), forbidden)
+    query = FootQuery(source=(0.385, 0.0, 0.525), preferred=(0.175, 0.525), hip=(0.385, 0.525), reach_xz=0.7,
+                      step_height=step, foot_length=0.03, foot_width=0.02, foot_yaw=0.0)
+    result = plan_foot(maps, query, budget=EXHAUSTIVE)
+    assert result.valid
+    assert result.target[0] < 0.385 - 2 * cell
+    assert result.metrics["climb_m"] == pytest.approx(box_height + margin - step, abs=1e-9)
+    assert result.trajectory[:, 1].max() <= 2 * step + margin + 1e-9
