@@ -805,7 +805,8 @@ def drawn_heights(dense, g_free, n, ceiling, out):
 
     A swing passes such cells only to leave a box that ran onto its foot, or where one is heading
     (:func:`_open_escape`). It is scored as climbing the box (the climb and the 3D length send it to a
-    footprint further away: scored without, 144 crowded runs had 2-3 x the feet in crates), but a foot
+    footprint further away: three variants scored without the climb had 2-7 x the feet in crates over
+    36-144 paired crowded runs), but a foot
     never climbs a forbidden box (forbidden at any height), and drawn over its top a spider's foot
     stepping 7 cm out of a crate's way rose 0.33 m, 0.2 m above its hip, and its folded leg crossed two
     others (crates-moving, 12 characters, seed 3, frame 252; over that 1200-frame run 125 swinging
@@ -916,6 +917,7 @@ def couple_metrics_2d(parent, passable, dt, elev_dil, code, source_p, target_p, 
     """The 2D part of a (target, slice) couple: the path from the slice's wavefront tree, its
     2D metrics, and the 2D climb over the elevations under the path (the 3D trajectory stays
     above them, so climb_3d >= climb_2d, and with length_3d >= length_2d, score_3d <= score_2d).
+    ``code`` (the ROI's cell codes) and ``g_free`` (filled) as in :func:`path_2d`.
     Returns (n_dense, length_2d, curvature, clearance, climb_2d); n_dense < 2: no path."""
     # A goal-only target cell (next to another leg, see footprint_candidates) is passable for
     # the path that ends in it, and only for that path.
