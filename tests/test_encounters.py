@@ -14,6 +14,7 @@ import pytest
 from conftest import fresh_seeds
 from footfall.planner._counters import FrameCounters
 from footfall.planner._crowd import DT, init_crowd, stage_steer, step
+from footfall.planner._kernels_foot import ESCAPE_RISE
 from footfall.scenarios import load_creature, load_scenario
 from footfall.scenarios._gait_schedule import gait_schedule
 
@@ -73,14 +74,18 @@ def _run(model, state, frames, each_frame):
     return counters
 
 
-def _run_feet_in_crate(model, state, frames):
-    """Run ``frames`` frames; (rendered foot-frames inside the crate where it is, the run's counters)."""
+def _run_feet_in_crate(model, state, frames, swing_heights=None):
+    """Run ``frames`` frames; (rendered foot-frames inside the crate where it is, the run's counters).
+    ``swing_heights``: a list that receives each frame's highest swinging (not tucked) foot, planned."""
     inside = []
 
     def check(s):
         c, h, y = _crate_now(model, s.t)
         feet = np.where(s.ik_on[0], s.fk_feet[0], s.feet[0])
         inside.append(int(_inside(feet[:, [0, 2]], c, h, y).sum()))
+        swinging = ~s.in_stance[0] & ~s.tucked[0]
+        if swing_heights is not None and swinging.any():
+            swing_heights.append(float(s.feet[0, swinging, 1].max()))
 
     counters = _run(model, state, frames, check)
     return sum(inside), counters
@@ -95,11 +100,15 @@ def test_a_crate_driven_across_a_stance_foot_makes_it_step_away_before_contact(t
     left = state.feet[0, :, 2] > 0.2
     centre, half, yaw = _crate_now(model, 7.5)
     assert _inside(state.feet[0][left][:, [0, 2]], centre, half, yaw).any(), "the crate must sweep a foot's spot"
-    inside, counters = _run_feet_in_crate(model, state, 450)
+    heights = []
+    inside, counters = _run_feet_in_crate(model, state, 450, heights)
     assert inside == 0
     assert counters.collisions == 0
     assert state.counters["steps"] > 0
     assert counters.max_stance_slip_m <= 1e-3
+    # A foot stepping out of the crate's way leaves through the cells where it is heading: drawn at most
+    # ESCAPE_RISE step heights (+ the obstacle margin) over the flat ground, not over the 0.3 m crate.
+    assert max(heights) <= ESCAPE_RISE * model.step_height + model.config.obstacle_margin_m + 1e-9, max(heights)
 
 
 def test_a_crate_crossing_a_planned_swing_replans_it_the_same_frame(tmp_path, monkeypatch):
