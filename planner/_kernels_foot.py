@@ -806,11 +806,10 @@ def drawn_heights(dense, g_free, n, ceiling, out):
     A swing passes such cells only to leave a box that ran onto its foot, or where one is heading
     (:func:`_open_escape`). It is scored as climbing the box (the climb and the 3D length send it to a
     footprint further away: three variants scored without the climb had 2-7 x the feet in crates over
-    36-144 paired crowded runs), but a foot
-    never climbs a forbidden box (forbidden at any height), and drawn over its top a spider's foot
-    stepping 7 cm out of a crate's way rose 0.33 m, 0.2 m above its hip, and its folded leg crossed two
-    others (crates-moving, 12 characters, seed 3, frame 252; over that 1200-frame run 125 swinging
-    foot-frames were more than 10 cm above their hip, up to 0.48 m)."""
+    36-144 paired crowded runs), but a foot never climbs a forbidden box (forbidden at any height), and
+    drawn over its top a spider's foot stepping 7 cm out of a crate's way rose 0.33 m, 0.2 m above its
+    hip, and its folded leg crossed two others (crates-moving, 12 characters, seed 3, frame 252; over
+    that 1200-frame run 125 swinging foot-frames were more than 10 cm above their hip, up to 0.48 m)."""
     lowered = False
     for i in range(n):
         out[i, 0] = dense[i, 0]
