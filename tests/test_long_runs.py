@@ -67,7 +67,8 @@ _WALKS_INTO = ("a character escaping a crate's lane walks at its speed into one 
 _HIDDEN_SNAP = ("a stance foot its leg could not reach (the body held, the IK 8.4 mm short) is drawn where it was planned"
                 " once its character goes off screen and its IK off: an 8.4 mm jump at the switch (stairs, ant, seed"
                 " 88250359, LOD zoomed, frame 565, found by the fresh seed of session 25's CI; the same before that"
-                " session's changes; traced)")
+                " session's changes; traced; stairs, robot5, seed 956051917, LOD zoomed, frame 409, character 3, leg 4:"
+                " a 2.0 mm jump, found by the fresh seed of session 29's CI, traced)")
 _LIFT_OFF_CROSS = ("a leg lifting off while the body turns is drawn over its neighbour, its knee only, for a frame"
                    " (stairs, spider, seed 1479478811, LOD zoomed, frame 259, found by a fresh seed of session 22's"
                    " review; the same on the crates-moving 1200-frame bar; traced)")
@@ -97,6 +98,7 @@ KNOWN: dict[tuple[str, str], dict[str, str]] = {
     ("mixed", "spider"): {"collisions": _FEET_IN, "leg_crossings": _CROSS, "stance_slip": _SLIP,
                           "body_overlaps": _WALKS_INTO},
     ("stairs", "ant"): {"leg_crossings": _CROSS, "stance_slip": _HIDDEN_SNAP},
+    ("stairs", "robot5"): {"stance_slip": _HIDDEN_SNAP},
     ("stairs", "spider"): {"leg_crossings": _LIFT_OFF_CROSS},
 }
 
@@ -128,6 +130,7 @@ FIXED_SEEDS: dict[tuple[str, str, str], tuple[int, ...]] = {
     ("mixed", "spider", "zoomed"): (900, 901, 1002, 1003, 1004, 1005, 666487550),
     ("stairs", "ant", "off"): (900,),
     ("stairs", "ant", "zoomed"): (1005, 88250359),
+    ("stairs", "robot5", "zoomed"): (956051917,),
     ("stairs", "spider", "zoomed"): (1479478811,),
 }
 
