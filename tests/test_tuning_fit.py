@@ -13,6 +13,16 @@ TAU = 0.05
 RESIDUAL_ATOL = 1e-12
 
 
+def _start_residuals(problem):
+    """``_fit.residuals`` at the harvest's parameters, as one compiled program: evaluated eagerly, each of
+    its primitives compiles a program of its own (seconds per test on a cold compilation cache)."""
+    import equinox as eqx
+
+    from footfall.tuning import _fit
+
+    return np.asarray(eqx.filter_jit(_fit.residuals)(_fit.initial_params(problem), problem))
+
+
 @pytest.fixture(scope="module")
 def problem():
     from footfall import tuning
@@ -33,7 +43,7 @@ def test_the_stride_residuals_are_the_targets_law(problem):
     from footfall.tuning import _fit
 
     s = problem.situations
-    r = np.asarray(_fit.residuals(_fit.initial_params(problem), problem))
+    r = _start_residuals(problem)
     mask = np.asarray(problem.stride_mask)
     assert mask.sum() > 10
     targets = tuning.load_targets(creatures=("spider", "ant"))
@@ -67,8 +77,8 @@ def test_the_stride_correction_scales_the_commanded_stride(problem):
     mask = np.asarray(problem.stride_mask)
     c = np.linspace(0.8, 1.25, s.n_situations)
     corrected = dataclasses.replace(problem, stride_correction=jnp.asarray(c))
-    r0 = np.asarray(_fit.residuals(_fit.initial_params(problem), problem))[:s.n_situations]
-    r1 = np.asarray(_fit.residuals(_fit.initial_params(corrected), corrected))[:s.n_situations]
+    r0 = _start_residuals(problem)[:s.n_situations]
+    r1 = _start_residuals(corrected)[:s.n_situations]
     tolerance = 0.15 * np.sqrt(mask.sum())  # relative_tolerance times the block normalisation
     # (c x / t - 1) / tol = c (x / t - 1) / tol + (c - 1) / tol
     np.testing.assert_allclose(r1[mask], c[mask] * r0[mask] + (c[mask] - 1.0) / tolerance, rtol=0, atol=1e-11)
@@ -90,7 +100,7 @@ def test_the_duty_correction_shifts_the_duty_model(problem):
     assert mask.any()
     d = np.full(s.n_situations, -0.3)  # far below every band
     shifted = dataclasses.replace(problem, duty_correction=jnp.asarray(d))
-    r = np.asarray(_fit.residuals(_fit.initial_params(shifted), shifted))
+    r = _start_residuals(shifted)
     block = r[s.n_situations:2 * s.n_situations]
     duty = np.asarray(tuning.duty_factor(s.timing0, s.speed, s.leg_height)) + d
     low, high = np.asarray(problem.duty_low), np.asarray(problem.duty_high)
@@ -111,7 +121,7 @@ def _targets():
 def test_levenberg_marquardt_lowers_the_loss_and_keeps_parameters_valid(problem):
     from footfall.tuning import _fit
 
-    loss0 = float(_fit.loss(_fit.initial_params(problem), problem))
+    loss0 = _fit.initial_loss(problem)
     weights, timing, history = _fit.fit(problem, n_steps=N_STEPS)
     assert history.shape == (N_STEPS,) and np.isfinite(history).all()
     assert history[-1] < loss0
@@ -171,10 +181,11 @@ def _weights_jacobian(problem):
     y0 = _fit.initial_params(problem)
     n_prior = y0[0].size + y0[1].size
 
+    @jax.jit  # one program: evaluated eagerly, each primitive would compile its own (seconds, cold cache)
     def f(log_weights):
         return _fit.residuals((log_weights, y0[1]), problem)[:-n_prior]
 
-    return f, y0[0], np.asarray(jax.jacfwd(f)(y0[0]))
+    return f, y0[0], np.asarray(jax.jit(jax.jacfwd(f))(y0[0]))
 
 
 @pytest.mark.slow  # jit-compiled fits (about 7 s each)
@@ -204,7 +215,7 @@ def test_the_weights_blocks_gradients_match_central_differences(terrain_problems
     # Off the defaults: clearance_ref_m = 0.07 m is the spider's cell, and many paths pass exactly one
     # cell from a blocked one, where min(1, clearance / clearance_ref_m) has its kink.
     x = x + jnp.log(jnp.asarray(np.random.default_rng(12).uniform(0.8, 1.25, x.size)))
-    jac = np.asarray(jax.jacfwd(f)(x))
+    jac = np.asarray(jax.jit(jax.jacfwd(f))(x))
     fd = np.empty_like(jac)
     step = 1e-5
     for j in range(x.size):
@@ -218,19 +229,23 @@ def test_the_offset_block_is_the_expected_distance_to_the_preferred_footprint(te
     from footfall import tuning
     from footfall.tuning import _fit
 
+    import equinox as eqx
+
+    from footfall.tuning._proxies import compiled_expected_metrics
+
     harvest, _, problem = terrain_problems
     s = problem.situations
-    r = np.asarray(_fit.residuals(_fit.initial_params(problem), problem))
+    r = _start_residuals(problem)
     n = s.n_situations
     start = 2 * n + 1 + 3  # stride, duty, slope, then jerk, curvature, clearance (one per creature)
     block = r[start:start + n]
     mask = np.asarray(problem.stride_mask)
-    m = tuning.expected_metrics(s.weights0, s.timing0, s, WEIGHTS_TAU, clearance_cap_m=problem.clearance_min_m)
+    m = compiled_expected_metrics(s.weights0, s.timing0, s, WEIGHTS_TAU, clearance_cap_m=problem.clearance_min_m)
     expected = np.asarray(m["offset_m"]) / (0.15 * np.asarray(problem.stride_target_m)) / np.sqrt(mask.sum())
     np.testing.assert_allclose(block[mask], expected[mask], rtol=1e-12, atol=0)
     assert (block[~mask] == 0).all() and (block[mask] > 0).all()
     # The offsets the hard choice makes: the soft expectation at this temperature is of the same size.
-    hard = np.asarray(tuning.hard_metrics(s.weights0, s.timing0, s)["offset_m"])[mask].mean()
+    hard = np.asarray(eqx.filter_jit(tuning.hard_metrics)(s.weights0, s.timing0, s)["offset_m"])[mask].mean()
     soft = np.asarray(m["offset_m"])[mask].mean()
     assert hard <= soft <= 2.0 * hard + 0.01, (hard, soft)
 
@@ -239,7 +254,7 @@ def test_a_weights_only_fit_moves_the_weights_and_holds_the_timing(terrain_probl
     from footfall.tuning import _fit
 
     _, _, problem = terrain_problems
-    loss0 = float(_fit.loss(_fit.initial_params(problem), problem))
+    loss0 = _fit.initial_loss(problem)
     weights, timing, history = _fit.fit(problem, n_steps=4)
     assert history[-1] < loss0
     np.testing.assert_array_equal(timing, np.asarray(problem.situations.timing0))

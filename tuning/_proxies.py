@@ -739,3 +739,10 @@ def _metrics_under(p, scores, timing, s, clearance_cap_m, touchdown_cap_m=None):
         "jerk": expect(raw[..., RAW_JERK]),
         "couple_score": expect(scores),
     }
+
+
+# The outer boundary's compiled forms, for callers outside a jit (the tune's Spearman check, the
+# metric-change validation): one program per shape and static argument, where an eager call compiles
+# a program for each primitive it meets (about a hundred per call on a cold compilation cache).
+compiled_couple_scores = eqx.filter_jit(couple_scores)
+compiled_expected_metrics = eqx.filter_jit(expected_metrics)

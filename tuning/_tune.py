@@ -404,7 +404,7 @@ def _harvest(config: TuneConfig, params: dict, seed: int, map_tasks=None):
 def _fit_round(config: TuneConfig, params: dict, exact_current: ExactMetrics, round_index: int, targets, map_tasks=None):
     """Harvest under ``params``, fit; returns (new params, fit record)."""
     from footfall.planner import GRAVITY
-    from footfall.tuning._fit import fit, initial_params, loss, make_problem
+    from footfall.tuning._fit import fit, initial_loss, make_problem
     from footfall.tuning._proxies import situations_from_harvest
 
     harvest = _harvest(config, params, config.seed + round_index, map_tasks)
@@ -417,7 +417,7 @@ def _fit_round(config: TuneConfig, params: dict, exact_current: ExactMetrics, ro
                            stride_correction=correction, duty_correction=duty_correction(exact_current, froude, leg))
     f, k, s = (int(x) for x in situations.couple_mask.shape)
     problem = _pad_problem(problem, _bucket(f, 128), _bucket(k, 32), _bucket(s, 4))
-    loss0 = float(loss(initial_params(problem), problem))
+    loss0 = initial_loss(problem)
     w, t, history = fit(problem, n_steps=config.fit_steps)
     record = {"situations": f, "padded_shape": [int(x) for x in problem.situations.couple_mask.shape],
               "proxy_loss_before": loss0, "proxy_loss_after": float(history[-1]),
@@ -433,11 +433,12 @@ def spearman_proxy_exact(config: TuneConfig, params: dict, map_tasks=None) -> tu
     import jax.numpy as jnp
     from scipy.stats import spearmanr
 
-    from footfall.tuning._proxies import couple_scores, situations_from_harvest
+    from footfall.tuning._proxies import compiled_couple_scores, situations_from_harvest
 
     harvest = _harvest(config, params, config.seed + 1000, map_tasks)
     situations = situations_from_harvest(harvest)
-    proxy = np.asarray(couple_scores(jnp.asarray(params["weights"]), jnp.asarray(params["timing"]), situations))
+    proxy = np.asarray(compiled_couple_scores(jnp.asarray(params["weights"]), jnp.asarray(params["timing"]),
+                                              situations))
     keep = np.asarray(harvest.has_couple)
     exact = harvest.couple_scores[keep][..., 0]
     mask = np.asarray(situations.couple_mask)

@@ -187,7 +187,7 @@ def style_start(params: dict, targets) -> dict:
 
 def _fit_round(config: EventTuneConfig, params: dict, round_index: int, targets, map_tasks):
     from footfall.tuning._harvest_runs import harvest_situations
-    from footfall.tuning._fit import fit, initial_params, loss, make_problem
+    from footfall.tuning._fit import fit, initial_loss, make_problem
     from footfall.tuning._proxies import situations_from_harvest
 
     weights, timing = _objects(params)
@@ -201,7 +201,7 @@ def _fit_round(config: EventTuneConfig, params: dict, round_index: int, targets,
                            prior_log_scale=config.prior_log_scale)
     f, k, s = (int(x) for x in situations.couple_mask.shape)
     problem = _pad_problem(problem, _bucket(f, 128), _bucket(k, 32), _bucket(s, 4))
-    loss0 = float(loss(initial_params(problem), problem))
+    loss0 = initial_loss(problem)
     w, _, history = fit(problem, n_steps=config.fit_steps)
     record = {"situations": f, "proxy_loss_before": loss0, "proxy_loss_after": float(history[-1]),
               "harvest_seed": config.seed + round_index}

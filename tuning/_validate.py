@@ -62,7 +62,7 @@ def metric_change_spearman(config, targets, n: int, map_tasks=None) -> dict:
     from footfall.tuning._harvest_runs import harvest_situations
     from footfall.tuning._config import enable_x64
     from footfall.tuning._events import CLEARANCE_CAP_H, event_metrics, spawn_variant
-    from footfall.tuning._proxies import expected_metrics, situations_from_harvest
+    from footfall.tuning._proxies import compiled_expected_metrics, situations_from_harvest
     from footfall.tuning._tune_events import HARVEST_SPAWN
 
     enable_x64()
@@ -78,7 +78,8 @@ def metric_change_spearman(config, targets, n: int, map_tasks=None) -> dict:
     t = jnp.asarray(timing.to_array())
 
     def proxy(w):
-        m = expected_metrics(jnp.asarray(w), t, situations, config.tau, clearance_cap_m=cap, touchdown_cap_m=cap)
+        m = compiled_expected_metrics(jnp.asarray(w), t, situations, config.tau, clearance_cap_m=cap,
+                                      touchdown_cap_m=cap)
         return {k: float(jnp.mean(m[k])) for k, _, _ in PAIRS}
 
     setup = config.setup()
