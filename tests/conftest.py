@@ -183,12 +183,14 @@ def footfall_cli(*args, cwd=None):
 # --------------------------------------------------------------------------- one main job per session
 @pytest.fixture(scope="session")
 def main_job(tmp_path_factory):
-    """``(out, summary)`` of one ``footfall run --quick --out OUT --json``, run once per test session.
+    """``(out, summary)`` of one ``footfall run --quick --workers 1 --out OUT --json``, once per test session.
 
     The main job's tune and report are the suite's two longest pieces of work; its report is the quick
     sweep with the recording's renders, which the report's tests read rather than sweep again. With
-    xdist the first worker to ask runs it and the others wait for it (the job itself keeps both cores
-    busy on its local worker processes): a file lock in the folder the workers share."""
+    xdist the first worker to ask runs it and the others wait for it: a file lock in the folder the
+    workers share. In one process (``--workers 1``): the suite keeps both cores busy on its own, and
+    the job's four local worker processes cost 21 s of CPU to start (69 -> 47 core-seconds for the job,
+    2026-11-26); the sweep and the tune on local workers are tests of their own (test_distributed*)."""
     import fcntl
     import json
     import subprocess
@@ -203,8 +205,9 @@ def main_job(tmp_path_factory):
         fcntl.flock(lock, fcntl.LOCK_EX)
         if not result.exists():
             env = dict(os.environ, VTK_DEFAULT_OPENGL_WINDOW="vtkEGLRenderWindow")
-            proc = subprocess.run([sys.executable, "-m", "footfall.cli", "run", "--quick", "--out", str(out), "--json"],
-                                  capture_output=True, text=True, timeout=900, env=env)
+            argv = ["run", "--quick", "--workers", "1", "--out", str(out), "--json"]
+            proc = subprocess.run([sys.executable, "-m", "footfall.cli", *argv], capture_output=True, text=True,
+                                  timeout=900, env=env)
             result.write_text(json.dumps({"returncode": proc.returncode, "stdout": proc.stdout,
                                           "stderr": proc.stderr[-4000:]}))
     done = json.loads(result.read_text())
