@@ -226,11 +226,10 @@ def test_the_weights_blocks_gradients_match_central_differences(terrain_problems
 
 
 def test_the_offset_block_is_the_expected_distance_to_the_preferred_footprint(terrain_problems):
-    from footfall import tuning
-    from footfall.tuning import _fit
-
     import equinox as eqx
 
+    from footfall import tuning
+    from footfall.tuning import _fit
     from footfall.tuning._proxies import compiled_expected_metrics
 
     harvest, _, problem = terrain_problems
