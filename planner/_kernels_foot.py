@@ -73,6 +73,13 @@ SIZE_INCREASE = 2  # free, but a foot centred here would touch a forbidden cell
 OTHER_LEG = 3  # another leg's projection or another foot
 PAD = 4  # the padding ring around the ROI
 
+
+@nb.njit(cache=True)
+def foot_blocked(c):
+    """Whether a foot centred on a cell of code ``c`` touches a forbidden box (FORBIDDEN, SIZE_INCREASE)."""
+    return c == FORBIDDEN or c == SIZE_INCREASE
+
+
 ESCAPE_RISE = 2.0
 """A swing leaving the cells of a forbidden box is drawn at most this many step heights above its
 source over them (:func:`drawn_heights`); it is scored as climbing the box."""
@@ -346,7 +353,7 @@ def footprint_candidates(code, elev_dil, elev_raw, r0, c0, hp, wp, origin_x, ori
     for p in range(n):
         if code[p] != PAD:
             inside[p] = 1
-            if code[p] == FORBIDDEN or code[p] == SIZE_INCREASE:
+            if foot_blocked(code[p]):
                 seed[p] = 1
     prox_dt = np.empty(n, dtype=np.float64)
     chamfer_distance(seed, inside, hp, wp, cell, prox_dt)
@@ -786,11 +793,11 @@ def path_2d(kept, passable, dt, elev_dil, code, source_p, target_p, r0, c0, hp, 
     for i in range(n):
         p = dense_p[i]
         g = elev_dil[p]
-        gf = elev_dil[p] if code[p] != FORBIDDEN and code[p] != SIZE_INCREASE else -np.inf
+        gf = -np.inf if foot_blocked(code[p]) else elev_dil[p]
         for q in (p - wp - 1, p - wp, p - wp + 1, p - 1, p + 1, p + wp - 1, p + wp, p + wp + 1):
             if passable[q] or q == source_p:
                 g = max(g, elev_dil[q])
-                if code[q] != FORBIDDEN and code[q] != SIZE_INCREASE:
+                if not foot_blocked(code[q]):
                     gf = max(gf, elev_dil[q])
         dense[i, 2] = g
         g_free[i] = gf
