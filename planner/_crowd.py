@@ -279,6 +279,9 @@ class CrowdModel:
     far_first: PlannerConfig | None = None
     far_fallback: PlannerConfig | None = None
     avoid_radius: float = math.nan  # m, the disc its characters keep clear of each other (avoid_radius)
+    # The static boxes grown by the way's clearance and their visibility graph (planner._navigation):
+    # steering aims at the first corner of the shortest way round them. None: straight at the route's points.
+    way_around: object = None
 
     @property
     def n_legs(self) -> int:
@@ -391,6 +394,7 @@ class CrowdState:
     counters: dict = field(default_factory=dict)
     lod_level: np.ndarray | None = None  # (C,) int8: each character's level of detail (planner._lod, LEVEL_*)
     near_moving_box: np.ndarray | None = None  # (C,) bool: a moving box is near: it plans as a near character
+    aim_node: np.ndarray | None = None  # (C,) int: the corner of the way round static boxes aimed at (-1: none)
 
 
 def hips_world(model: CrowdModel, state: CrowdState) -> np.ndarray:
@@ -487,7 +491,19 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
         d = target - state.pelvis[:, [0, 2]]
         dist = np.hypot(d[:, 0], d[:, 1])
     arrived = (dist < ctl.arrive_radius) & (state.route_index == last)
-    direction = d / np.maximum(dist, 1e-9)[:, None]
+    if model.way_around is not None and model.way_around.n_boxes:
+        # Round the static boxes: aimed straight at a route point behind a forbidden one, ORCA slid the
+        # character along its face at a few cm/s (planner._navigation).
+        from footfall.planner._navigation import REFRESH_FRAMES, aim_points
+
+        if state.aim_node is None:
+            state.aim_node = np.full(n, -1, np.int64)
+        aim, _ = aim_points(model.way_around, state.pelvis[:, [0, 2]], target, state.aim_node, state.frame,
+                            REFRESH_FRAMES)
+        to_aim = aim - state.pelvis[:, [0, 2]]
+        direction = to_aim / np.maximum(np.hypot(to_aim[:, 0], to_aim[:, 1]), 1e-9)[:, None]
+    else:
+        direction = d / np.maximum(dist, 1e-9)[:, None]
     centres, sizes, yaws, forbidden, _ = boxes
     if forbidden.any():
         bc = centres[forbidden][:, [0, 2]]
@@ -2084,6 +2100,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
     rng = np.random.default_rng(seed)
     positions = spawn_positions(scenario, creature, n)
     model = dataclasses.replace(model, avoid_radius=avoid_radius(creature, model.rest_radius, positions))
+    model = dataclasses.replace(model, way_around=static_way_around(raster.obstacles, model.avoid_radius))
     if scenario.crowd.heading_mode == "random":
         headings = rng.uniform(-math.pi, math.pi, n)
     else:
@@ -2122,12 +2139,27 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         escaping=np.zeros(n, np.bool_), goal_speed=np.full(n, speed), blocks_escape=np.zeros((n, L), np.bool_), crossed=np.zeros((n, L, L), np.bool_),
         counters={k: 0 for k in ("steps", "plans", "holds", "replans", "forbidden_footprints", "cells_expanded",
                                  "couples_evaluated", "pose_takebacks", "crossing_takebacks", "map_cells_built", "ik_ccd_legs", "ik_two_bone_legs")},
-        lod_level=np.full(n, LEVEL_FULL, np.int8), near_moving_box=np.zeros(n, np.bool_))
+        lod_level=np.full(n, LEVEL_FULL, np.int8), near_moving_box=np.zeros(n, np.bool_),
+        aim_node=np.full(n, -1, np.int64))
     stage_pelvis(model, state, smoothing=1.0)  # the first pose is the hull's own
     state.pelvis_rise[:] = 0.0
     state.pose_before = _pose(state)  # nothing to take back before the first frame
     stage_ik(model, state, np.ones(n, np.bool_))
     return model, state
+
+
+def static_way_around(obstacles, avoid_radius: float):
+    """The :class:`planner._navigation.WayAround` of the static boxes of ``obstacles`` (safe ones included:
+    see there), grown by ``CLEARANCE_FACTOR`` avoid radii; None when there are none."""
+    from footfall.planner._navigation import CLEARANCE_FACTOR, way_around
+
+    if len(obstacles.yaws) == 0:
+        return None
+    keep = np.asarray(obstacles.is_static, np.bool_)
+    if not keep.any():
+        return None
+    return way_around(np.asarray(obstacles.centres)[keep][:, [0, 2]], np.asarray(obstacles.sizes)[keep][:, [0, 2]],
+                      np.asarray(obstacles.yaws)[keep], CLEARANCE_FACTOR * avoid_radius)
 
 
 def _same_boxes(a, b) -> bool:
