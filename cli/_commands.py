@@ -242,6 +242,8 @@ def simulate_cmd(
     preset: Optional[str] = typer.Option(None, help="Weight preset for this creature: a .json file or a shipped "
                                          "one by name (spider, ant, ...)"),
     record: Optional[str] = typer.Option(None, help="Save the recording (.npz)"),
+    navigate: bool = typer.Option(False, "--navigate", help="Steer round static boxes and the loops of moving "
+                                  "ones (off by default; README: the way round static boxes)"),
     json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),
 ) -> None:
     """Simulate a crowd walking through a scenario and report what happened."""
@@ -265,7 +267,7 @@ def simulate_cmd(
                   disable=json_out or not _err().is_terminal) as bar:
         task = bar.add_task("frames", total=frames)
         model, summary, recorder = recorded_run(s, c, g, frames=frames, characters=characters, seed=seed, preset=p,
-                                                lod=lod, record=record is not None,
+                                                lod=lod, record=record is not None, navigate=navigate,
                                                 progress=lambda k: bar.update(task, completed=k))
     if record:
         recorder.save(record, model, summary, recording_meta(s, seed, lod, g))
@@ -304,6 +306,8 @@ def evaluate_cmd(
     out: Optional[str] = typer.Option(None, "--out", help="Folder for index.html, evaluate.json, runs.csv and "
                                       "pictures of the worst runs"),
     strict: bool = typer.Option(False, "--strict", help="Exit 1 when any promise is violated"),
+    navigate: bool = typer.Option(False, "--navigate", help="Every run steers round static boxes and the loops of "
+                                  "moving ones (as simulate --navigate)"),
     json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),
 ) -> None:
     """Check every promise on scenario x creature x seed runs; list the violations.
@@ -340,12 +344,13 @@ violations and the exact command that replays each of the worst runs.
                   TimeElapsedColumn(), console=err, transient=True, disable=not err.is_terminal) as bar:
         task = bar.add_task("runs", total=total)
         result = evaluate(names, kinds, drawn, characters=characters, frames=frames, lod=lod, workers=workers,
-                          cluster=cluster, progress=lambda _t, done: bar.update(task, completed=done))
+                          cluster=cluster, progress=lambda _t, done: bar.update(task, completed=done),
+                          navigate=navigate)
     if out is not None:
         pictures = {}
         for k, run in enumerate(result["failed_runs"][:3]):
             pictures[f"worst-{k}.png"] = picture_png(run_one({**run, "characters": characters, "frames": frames,
-                                                              "lod": lod, "picture": True}))
+                                                              "lod": lod, "navigate": navigate, "picture": True}))
         write_outputs(Path(out), result, pictures)
     public = {k: v for k, v in result.items() if not k.startswith("_")}
     if json_out:

@@ -140,6 +140,8 @@ class ControllerConfig:
         Other characters' bodies and feet are forbidden in the local maps.
     avoid_others_feet : bool
         Other characters' feet near a planned footprint keep a foot's room.
+    navigate : bool
+        Steer round the static boxes and the regions looping boxes sweep (``planner._navigation``).
 
     Examples
     --------
@@ -193,6 +195,15 @@ class ControllerConfig:
     others_in_maps: bool = False
     # Other characters' feet near a planned footprint keep a foot's room (stage_plan, _with_neighbours_feet).
     avoid_others_feet: bool = True
+    # Steering aims at the first corner of the shortest way round the static boxes and the regions that
+    # looping boxes sweep (planner._navigation). Off by default (2026-11-26): on 18 runs of 8 spiders x 600
+    # frames on `mixed` (seeds 1100-1111, 1200-1205) it takes feet in boxes 233 -> 0, crossing frames
+    # 54 -> 3, stuck 187 -> 10 s, and on the crowds bar set (`footfall evaluate --seeds 10 --seed-base 3000
+    # --characters 6 --frames 300`) stuck 117 -> 68 s; but there robot5 on `mixed` stalls at the corners
+    # (stuck 0 -> 46 s), one robot5 run on `crates-moving` puts a foot in a box, the runs over the
+    # per-stride bars go 90 -> 95 (more turns), and a spider turning 1 rad on its first steps
+    # (`mixed`, 3 spiders, seed 5) crosses two swinging legs for 2 frames.
+    navigate: bool = False
 
     def __post_init__(self) -> None:
         if not (self.pelvis_lag >= 0.0 and math.isfinite(self.pelvis_lag)):
@@ -2100,7 +2111,8 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
     rng = np.random.default_rng(seed)
     positions = spawn_positions(scenario, creature, n)
     model = dataclasses.replace(model, avoid_radius=avoid_radius(creature, model.rest_radius, positions))
-    model = dataclasses.replace(model, way_around=static_way_around(raster.obstacles, model.avoid_radius))
+    if controller.navigate:
+        model = dataclasses.replace(model, way_around=static_way_around(raster.obstacles, model.avoid_radius))
     if scenario.crowd.heading_mode == "random":
         headings = rng.uniform(-math.pi, math.pi, n)
     else:
@@ -2149,17 +2161,31 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
 
 
 def static_way_around(obstacles, avoid_radius: float):
-    """The :class:`planner._navigation.WayAround` of the static boxes of ``obstacles`` (safe ones included:
-    see there), grown by ``CLEARANCE_FACTOR`` avoid radii; None when there are none."""
+    """The :class:`planner._navigation.WayAround` of ``obstacles`` for characters of ``avoid_radius``: every
+    static box (safe ones included) and the region each box looping along waypoints sweeps (the bounding
+    box of its loop grown by half the box's diagonal), grown by ``CLEARANCE_FACTOR`` avoid radii; None
+    when there are none. Boxes moving at a constant velocity cross the world: the lane exit and ORCA keep
+    out of their way."""
     from footfall.planner._navigation import CLEARANCE_FACTOR, way_around
 
     if len(obstacles.yaws) == 0:
         return None
     keep = np.asarray(obstacles.is_static, np.bool_)
-    if not keep.any():
+    centres = [np.asarray(obstacles.centres)[keep][:, [0, 2]]]
+    sizes = [np.asarray(obstacles.sizes)[keep][:, [0, 2]]]
+    yaws = [np.asarray(obstacles.yaws)[keep]]
+    # A looping box has its waypoints (every other box an empty list: scenarios.Obstacles).
+    for b in [b for b, points in enumerate(obstacles.waypoints or ()) if len(points)]:
+        points = np.asarray(obstacles.waypoints[b])[:, [0, 2]]
+        lo, hi = points.min(axis=0), points.max(axis=0)
+        diagonal = float(np.hypot(*np.asarray(obstacles.sizes)[b, [0, 2]]))  # the box at any yaw
+        centres.append((0.5 * (lo + hi))[None])
+        sizes.append((hi - lo + diagonal)[None])
+        yaws.append(np.zeros(1))
+    centres, sizes, yaws = np.vstack(centres), np.vstack(sizes), np.concatenate(yaws)
+    if centres.shape[0] == 0:
         return None
-    return way_around(np.asarray(obstacles.centres)[keep][:, [0, 2]], np.asarray(obstacles.sizes)[keep][:, [0, 2]],
-                      np.asarray(obstacles.yaws)[keep], CLEARANCE_FACTOR * avoid_radius)
+    return way_around(centres, sizes, yaws, CLEARANCE_FACTOR * avoid_radius)
 
 
 def _same_boxes(a, b) -> bool:

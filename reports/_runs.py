@@ -7,19 +7,19 @@ from pathlib import Path
 
 
 def recorded_run(scenario, creature, gait, *, frames: int, characters: int | None = None, seed: int = 0,
-                 preset=None, lod: str = "off", record: bool = True, progress=None):
+                 preset=None, lod: str = "off", record: bool = True, progress=None, navigate: bool = False):
     """Simulate ``frames`` frames of the scenario's crowd; returns (model, summary, recorder or None).
 
     ``preset``: a loaded :class:`planner.Preset` (its weights and timing), or None for the defaults.
-    ``progress(k)`` is called after frame k.
+    ``progress(k)`` is called after frame k. ``navigate``: ``ControllerConfig.navigate``.
     """
-    from footfall.planner._crowd import init_crowd
+    from footfall.planner._crowd import ControllerConfig, init_crowd
     from footfall.planner._simulation import Recorder, simulate
 
     weights = preset.weights if preset is not None else None
     timing = preset.timing if preset is not None else None
     model, state = init_crowd(scenario, creature, gait, n_characters=characters, seed=seed, weights=weights,
-                              timing=timing, lod_mode=lod)
+                              timing=timing, lod_mode=lod, controller=ControllerConfig(navigate=navigate))
     recorder = Recorder(model, state, frames) if record else None
     say_speed_cap(model)
     summary = simulate(model, state, frames, recorder, progress=progress)

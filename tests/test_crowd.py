@@ -413,17 +413,16 @@ def test_a_crowd_spawns_with_every_foot_a_foots_room_from_the_other_characters_f
 def test_a_crowds_feet_keep_a_foots_room_from_each_other():
     """16 spiders on ``crates``: no two stance feet of different characters closer than a foot length
     (``shared_foot_spots``), because every planned foot keeps a foot's room from the other characters'
-    feet near it (where they stand, or will land). Without that, the same run shares spots (seed 0: 11
-    pair-frames; seed 7 did until the characters walked round the static crates, seed 5 until characters
-    standing still were avoided with the whole effort: then their crowds never brought two feet
-    together)."""
+    feet near it (where they stand, or will land). Without that, the same run shares spots (seed 7: 6
+    pair-frames; seed 5 did until characters standing still were avoided with the whole effort, and
+    then its crowd never brought two feet together)."""
     import dataclasses
 
     scenario, creature = load_scenario("crates"), load_creature("spider")
     counts = {}
     for avoid in (True, False):
         model, state = init_crowd(scenario, creature, load_gait(default_gait_name("spider"), creature),
-                                  n_characters=16, seed=0, lod_mode="off", raster=_raster(scenario, creature))
+                                  n_characters=16, seed=7, lod_mode="off", raster=_raster(scenario, creature))
         model = dataclasses.replace(model, controller=dataclasses.replace(model.controller, avoid_others_feet=avoid))
         counts[avoid] = simulate(model, state, 200).shared_foot_spots
     assert counts[True] == 0

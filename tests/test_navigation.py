@@ -142,25 +142,24 @@ goal = [2.5, 0.0]
 
 
 def _behind_a_crate(tmp_path, navigate: bool):
-    import dataclasses
-
     from footfall.planner import init_crowd
     from footfall.scenarios import default_gait, load_creature, load_scenario
+
+    from footfall.planner import ControllerConfig
 
     path = tmp_path / "behind-a-crate.toml"
     path.write_text(BEHIND_A_CRATE)
     quadruped = load_creature("quadruped")
-    model, state = init_crowd(load_scenario(str(path)), quadruped, default_gait(quadruped), n_characters=1, seed=0)
-    assert model.way_around is not None and model.way_around.n_boxes == 1
-    if not navigate:
-        model = dataclasses.replace(model, way_around=None)
+    model, state = init_crowd(load_scenario(str(path)), quadruped, default_gait(quadruped), n_characters=1, seed=0,
+                              controller=ControllerConfig(navigate=navigate))
+    assert (model.way_around is not None and model.way_around.n_boxes == 1) if navigate else model.way_around is None
     return model, state
 
 
 def test_a_quadruped_whose_goal_lies_behind_a_forbidden_crate_walks_round_it(tmp_path):
     """The stuck case of the crowds issue's bar set, alone: a quadruped walking at a 2 m wide forbidden
     crate dead ahead, its goal straight behind it. Aimed round the crate it is well past it after 15 s;
-    steered straight at the goal (``way_around`` None, the steering before it), ORCA slid it along the
+    steered straight at the goal (``ControllerConfig.navigate`` off, the default), ORCA slid it along the
     crate's face and it is barely past (x 0.41; in crowds such characters stalled)."""
     from footfall.planner import simulate
 
@@ -172,3 +171,41 @@ def test_a_quadruped_whose_goal_lies_behind_a_forbidden_crate_walks_round_it(tmp
     assert summary.stuck_seconds == 0.0 and summary.collisions == 0
     assert x > 1.0, f"past the crate (its far face at x = 0.3): x = {x:.2f}"
     assert x_straight < 0.5, "the case must be slow without the way round"
+
+
+def test_the_crowds_way_rounds_static_boxes_and_the_region_a_looping_box_sweeps():
+    """``static_way_around``: a static forbidden box, a safe one, a box looping round a 2 x 1 m rectangle
+    (its region: the loop's bounding box grown by half the box's 0.5 m diagonal on each side) and a
+    box moving at a constant velocity (not in the graph); every region grown by 1.2 avoid radii."""
+    from footfall.planner._crowd import static_way_around
+    from footfall.planner._navigation import CLEARANCE_FACTOR
+    from footfall.scenarios import Obstacles
+
+    boxes = Obstacles([[0.0, 0.1, 0.0], [3.0, 0.05, 0.0], [6.0, 0.1, 1.0], [0.0, 0.1, 5.0]],
+                      [[0.4, 0.2, 0.2], [0.6, 0.1, 0.6], [0.3, 0.2, 0.4], [0.2, 0.2, 0.2]], [0.3, 0.0, 0.0, 0.0],
+                      [True, False, True, True], motion_kind=[0, 0, 2, 1],
+                      velocities=[[0, 0, 0], [0, 0, 0], [0, 0, 0], [0.3, 0.0, 0.0]],
+                      waypoints=[np.zeros((0, 3)), np.zeros((0, 3)),
+                                 np.array([[6.0, 0.1, 1.0], [8.0, 0.1, 1.0], [8.0, 0.1, 2.0], [6.0, 0.1, 2.0]]),
+                                 np.zeros((0, 3))], waypoint_speed=[0.0, 0.0, 0.3, 0.0])
+    way = static_way_around(boxes, 0.25)
+    grow = CLEARANCE_FACTOR * 0.25
+    np.testing.assert_allclose(way.centres, [[0.0, 0.0], [3.0, 0.0], [7.0, 1.5]])
+    np.testing.assert_allclose(way.half, [[0.2 + grow, 0.1 + grow], [0.3 + grow, 0.3 + grow],
+                                          [1.0 + 0.25 + grow, 0.5 + 0.25 + grow]])
+    np.testing.assert_allclose(np.arctan2(way.sin_yaw, way.cos_yaw), [0.3, 0.0, 0.0])
+    assert static_way_around(Obstacles.empty(), 0.25) is None
+
+
+def test_simulate_and_evaluate_take_navigate_and_the_replay_says_so():
+    import json
+
+    from conftest import footfall_cli
+    from footfall.reports._evaluate import replay_command
+
+    done = footfall_cli("simulate", "crates", "--frames", "20", "--characters", "2", "--navigate", "--json")
+    assert done.returncode == 0, done.stderr
+    assert json.loads(done.stdout)["frames"] == 20
+    run = dict(scenario="crates", creature="spider", seed=3, characters=6, frames=300, lod="off")
+    assert replay_command(run).endswith("--lod off --json")
+    assert replay_command({**run, "navigate": True}).endswith("--lod off --navigate --json")
