@@ -290,8 +290,9 @@ class CrowdModel:
     far_first: PlannerConfig | None = None
     far_fallback: PlannerConfig | None = None
     avoid_radius: float = math.nan  # m, the disc its characters keep clear of each other (avoid_radius)
-    # The static boxes grown by the way's clearance and their visibility graph (planner._navigation):
-    # steering aims at the first corner of the shortest way round them. None: straight at the route's points.
+    # With ControllerConfig.navigate: the static boxes and the regions looping boxes sweep, grown by the way's
+    # clearance, and their visibility graph (planner._navigation, static_way_around): steering aims at the first
+    # corner of the shortest way round them. None: straight at the route's points.
     way_around: object = None
 
     @property
