@@ -270,7 +270,7 @@ def simulate_cmd(
                                                 lod=lod, record=record is not None, navigate=navigate,
                                                 progress=lambda k: bar.update(task, completed=k))
     if record:
-        recorder.save(record, model, summary, recording_meta(s, seed, lod, g))
+        recorder.save(record, model, summary, recording_meta(s, seed, lod, g, navigate))
     if json_out:
         print(json.dumps(summary.to_json()))
         return

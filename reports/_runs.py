@@ -35,9 +35,12 @@ def say_speed_cap(model) -> None:
               f"{model.speed_cap:.3g} m/s, the fastest its legs carry at the stride law", file=sys.stderr)
 
 
-def recording_meta(scenario, seed: int, lod: str, gait) -> dict:
-    """What a recording's header says about its run, beside the recorder's own fields."""
+def recording_meta(scenario, seed: int, lod: str, gait, navigate: bool = False) -> dict:
+    """What a recording's header says about its run, beside the recorder's own fields (``navigate``:
+    only when on, so the recordings of default runs keep their header)."""
     meta = {"scenario": scenario.name, "seed": int(seed), "lod": lod, "gait": gait.name}
+    if navigate:
+        meta["navigate"] = True
     if not scenario.source.startswith("builtin:"):  # a user's scenario file: where to find it again
         meta["scenario_file"] = str(Path(scenario.source).resolve())
     return meta

@@ -197,15 +197,18 @@ def test_the_crowds_way_rounds_static_boxes_and_the_region_a_looping_box_sweeps(
     assert static_way_around(Obstacles.empty(), 0.25) is None
 
 
-def test_simulate_and_evaluate_take_navigate_and_the_replay_says_so():
+def test_simulate_and_evaluate_take_navigate_and_the_replay_says_so(tmp_path):
     import json
 
     from conftest import footfall_cli
     from footfall.reports._evaluate import replay_command
 
-    done = footfall_cli("simulate", "crates", "--frames", "20", "--characters", "2", "--navigate", "--json")
+    path = tmp_path / "run.npz"
+    done = footfall_cli("simulate", "crates", "--frames", "20", "--characters", "2", "--navigate", "--record", str(path),
+                        "--json")
     assert done.returncode == 0, done.stderr
     assert json.loads(done.stdout)["frames"] == 20
+    assert json.loads(str(np.load(path)["header"]))["navigate"] is True  # the recording says how it was run
     run = dict(scenario="crates", creature="spider", seed=3, characters=6, frames=300, lod="off")
     assert replay_command(run).endswith("--lod off --json")
     assert replay_command({**run, "navigate": True}).endswith("--lod off --navigate --json")
