@@ -2176,9 +2176,11 @@ def static_way_around(obstacles, avoid_radius: float):
     sizes = [np.asarray(obstacles.sizes)[keep][:, [0, 2]]]
     yaws = [np.asarray(obstacles.yaws)[keep]]
     # A looping box has its waypoints (every other box an empty list: scenarios.Obstacles).
-    for b in [b for b, points in enumerate(obstacles.waypoints or ()) if len(points)]:
-        points = np.asarray(obstacles.waypoints[b])[:, [0, 2]]
-        lo, hi = points.min(axis=0), points.max(axis=0)
+    for b, points in enumerate(obstacles.waypoints or ()):
+        if not len(points):
+            continue
+        xz = np.asarray(points)[:, [0, 2]]
+        lo, hi = xz.min(axis=0), xz.max(axis=0)
         diagonal = float(np.hypot(*np.asarray(obstacles.sizes)[b, [0, 2]]))  # the box at any yaw
         centres.append((0.5 * (lo + hi))[None])
         sizes.append((hi - lo + diagonal)[None])
