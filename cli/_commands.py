@@ -242,8 +242,9 @@ def simulate_cmd(
     preset: Optional[str] = typer.Option(None, help="Weight preset for this creature: a .json file or a shipped "
                                          "one by name (spider, ant, ...)"),
     record: Optional[str] = typer.Option(None, help="Save the recording (.npz)"),
-    navigate: bool = typer.Option(False, "--navigate", help="Steer round static boxes and the loops of moving "
-                                  "ones (off by default; README: the way round static boxes)"),
+    navigate: bool = typer.Option(True, "--navigate/--no-navigate", help="Steer round static boxes and the loops "
+                                  "of moving ones (README: the way round static boxes); --no-navigate: ORCA and "
+                                  "the box push alone, as before 2026-11-26"),
     json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),
 ) -> None:
     """Simulate a crowd walking through a scenario and report what happened."""
@@ -306,8 +307,8 @@ def evaluate_cmd(
     out: Optional[str] = typer.Option(None, "--out", help="Folder for index.html, evaluate.json, runs.csv and "
                                       "pictures of the worst runs"),
     strict: bool = typer.Option(False, "--strict", help="Exit 1 when any promise is violated"),
-    navigate: bool = typer.Option(False, "--navigate", help="Every run steers round static boxes and the loops of "
-                                  "moving ones (as simulate --navigate)"),
+    navigate: bool = typer.Option(True, "--navigate/--no-navigate", help="Every run steers round static boxes and "
+                                  "the loops of moving ones (as simulate; --no-navigate: as simulate --no-navigate)"),
     json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),
 ) -> None:
     """Check every promise on scenario x creature x seed runs; list the violations.

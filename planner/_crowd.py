@@ -196,14 +196,13 @@ class ControllerConfig:
     # Other characters' feet near a planned footprint keep a foot's room (stage_plan, _with_neighbours_feet).
     avoid_others_feet: bool = True
     # Steering aims at the first corner of the shortest way round the static boxes and the regions that
-    # looping boxes sweep (planner._navigation). Off by default (2026-11-26): on 18 runs of 8 spiders x 600
-    # frames on `mixed` (seeds 1100-1111, 1200-1205) it takes feet in boxes 233 -> 0, crossing frames
-    # 54 -> 3, stuck 187 -> 10 s, and on the crowds bar set (`footfall evaluate --seeds 10 --seed-base 3000
-    # --characters 6 --frames 300`) stuck 117 -> 68 s; but there robot5 on `mixed` stalls at the corners
-    # (stuck 0 -> 46 s), one robot5 run on `crates-moving` puts a foot in a box, the runs over the
-    # per-stride bars go 90 -> 95 (more turns), and a spider turning 1 rad on its first steps
-    # (`mixed`, 3 spiders, seed 5) crosses two swinging legs for 2 frames.
-    navigate: bool = False
+    # looping boxes sweep (planner._navigation). On by default since 2026-11-26: crowds of 8, 16 and 64
+    # spiders x 600 frames on `mixed` and `crates` (seeds 1-3) go from 628 foot-frames in boxes, 149
+    # crossing frames and 473 stuck s to 0, 10 and 225 s (overlaps and shared spots 0 both ways); the crowds
+    # bar set (`footfall evaluate --seeds 10 --seed-base 3000 --characters 6 --frames 300`): stuck 117 ->
+    # 71 s, slipping runs 1 -> 0, crossing frames 0 -> 1, runs over the per-stride bars 90 -> 96. Off
+    # (`--no-navigate`): ORCA and the box push alone.
+    navigate: bool = True
 
     def __post_init__(self) -> None:
         if not (self.pelvis_lag >= 0.0 and math.isfinite(self.pelvis_lag)):
@@ -1054,11 +1053,14 @@ def _foot_room(model: CrowdModel) -> float:
     return math.hypot(model.creature.foot_length, model.creature.foot_width)
 
 
-def _same_frame_conflicts(model: CrowdModel, cs, targets, valid) -> np.ndarray:
+def _same_frame_conflicts(model: CrowdModel, cs, targets, valid, hips=None) -> np.ndarray:
     """(F,) bool: valid plans whose target lies within a foot's room of an earlier valid plan's target
     (this frame's plans): of another character, or of the same one (two legs of a character planned
     in one frame do not see each other's targets either: on a variant of the runtime, a spider's
-    adjacent rear legs landed on one spot and crossed)."""
+    adjacent rear legs landed on one spot and crossed). With ``hips`` (F, 2) x, z at touchdown, also
+    a plan whose ground line (hip to target) crosses an earlier plan's of the same character: a
+    spider's two rear left legs, lifted together while it turned, were given targets whose lines
+    crossed, and the legs were drawn crossed mid-swing (``mixed``, 3 spiders, seed 5)."""
     conflict = np.zeros(cs.size, dtype=np.bool_)
     if np.count_nonzero(valid) < 2:
         return conflict
@@ -1071,7 +1073,37 @@ def _same_frame_conflicts(model: CrowdModel, cs, targets, valid) -> np.ndarray:
         a, b = idx[pairs[:, 0]], idx[pairs[:, 1]]
         counted = (cs[a] == cs[b]) | model.controller.avoid_others_feet
         conflict[np.maximum(a, b)[counted]] = True
+    if hips is not None:
+        a, b = _same_character_pairs(cs, idx)
+        if a.size:
+            crossed = _segments_cross(hips[a], targets[a][:, [0, 2]], hips[b], targets[b][:, [0, 2]])
+            conflict[b[crossed]] = True
     return conflict
+
+
+def _same_character_pairs(cs, idx) -> tuple[np.ndarray, np.ndarray]:
+    """(a, b): every pair of the plans ``idx`` (ascending) of one character, a before b."""
+    order = idx[np.argsort(cs[idx], kind="stable")]
+    a_parts, b_parts = [], []
+    for d in range(1, order.size):
+        same = cs[order[:-d]] == cs[order[d:]]
+        if not same.any():
+            break  # sorted by character: no group holds more than d plans
+        a_parts.append(order[:-d][same])
+        b_parts.append(order[d:][same])
+    if not a_parts:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    a, b = np.concatenate(a_parts), np.concatenate(b_parts)
+    return np.minimum(a, b), np.maximum(a, b)
+
+
+def _segments_cross(p0, p1, q0, q1) -> np.ndarray:
+    """(N,) bool: segments p0 -> p1 and q0 -> q1 ((N, 2) each) cross properly (each one's ends strictly
+    on both sides of the other's line)."""
+    def side(a, b, c):
+        return (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
+
+    return ((side(p0, p1, q0) * side(p0, p1, q1) < 0.0) & (side(q0, q1, p0) * side(q0, q1, p1) < 0.0))
 
 
 def _with_neighbours_feet(model: CrowdModel, state: CrowdState, cs, own, preferred, support):
@@ -1497,10 +1529,10 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
         early=np.full(f, model.fixed_budget is None or model.fixed_budget.paper_early_stop, np.bool_))
     out, calls = _plan_groups(model, state, request, cs, maps, groups, boxes)
     batch = calls[0][0] if len(calls) == 1 and not groups[0][1] else None
-    # Feet of different characters planned in the same frame do not see each other's targets: of two
-    # that would land within a foot's room of each other, the later one (in plan order) waits a frame
-    # and plans again, seeing the other's target.
-    ok = out.valid & ~_same_frame_conflicts(model, cs, out.target, out.valid)
+    # Feet planned in the same frame do not see each other's targets: of two that would land within a
+    # foot's room of each other, or two legs of one character whose ground lines would cross, the later
+    # one (in plan order) waits a frame and plans again, seeing the other's target.
+    ok = out.valid & ~_same_frame_conflicts(model, cs, out.target, out.valid, hip_pred)
     vc, vl = cs[ok], ls[ok]
     state.trajectories[vc, vl] = out.trajectory[ok]
     state.swing_t[vc, vl] = 0.0

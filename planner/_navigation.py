@@ -7,8 +7,8 @@ at a few cm/s: in the crowds issue's bar set (``footfall evaluate --seeds 10 --s
 --characters 6 --frames 300``) every stuck character-second was such a character (quadrupeds on
 ``mixed``: 42 s, spiders on ``crates``: 30 s).
 
-So with ``ControllerConfig.navigate`` (off by default: the README's section on the way round static
-boxes has what it costs) steering aims at the first corner of the shortest way round the boxes, and at
+So with ``ControllerConfig.navigate`` (on by default; the README's section on the way round static
+boxes has what it gains and costs) steering aims at the first corner of the shortest way round the boxes, and at
 the route's point itself whenever nothing is in the way. The boxes are the static ones, safe ones
 included: a character walks round a crate where the way round is free, and over a safe one only when
 none is (led over safe crates beside the forbidden ones it went round, robot5's legs could not follow
@@ -32,8 +32,10 @@ Rules that keep the graph well defined:
 * a segment is blocked by the open interior of a grown rectangle: it may touch a corner or run along
   an edge (nodes sit :data:`NODE_EPS` outside their corners, so edges between them stay outside);
 * a rectangle that contains the character (it stands closer to a box than the clearance) or the
-  route point blocks the segments from it (or to it) only where they enter the box itself: the way
-  out of it is open, the way through the box is not;
+  route point blocks the segments from it (or to it) only where they come nearer the box than ORCA's
+  disc, or than it is if that is nearer: the way out of it and along it is open, a way ORCA would
+  refuse is not; a box that contains it (a route point in a looping box's region) does not block
+  them;
 * with no way at all (the route point walled in), the aim is the route point (ORCA as before).
 
 The node-to-node visibility is computed once per crowd (:func:`way_around`); per frame, a character
@@ -187,10 +189,24 @@ def _segment_enters(ax, az, bx, bz, cx, cz, hx, hz, c, s):
 
 
 @nb.njit(cache=True)
+def _depth_margin(px, pz, cx, cz, hx, hz, c, s, clearance):
+    """m: how far a point inside a grown box is outside the box itself, along the box's axes (the
+    larger of the two; 0 inside the box)."""
+    u, v = _local(px, pz, cx, cz, c, s)
+    return max(abs(u) - (hx - clearance), abs(v) - (hz - clearance), 0.0)
+
+
+@nb.njit(cache=True)
 def _clear(ax, az, bx, bz, centres, half, cos_yaw, sin_yaw, clearance, own_a, own_b):
     """Whether segment a -> b enters no grown box. With ``own_a`` (``own_b``), a grown box that contains
-    a (b) only blocks the segment if it enters the box itself (grown by nothing): a character standing
-    nearer a box than the clearance may walk out of it, but not through the box."""
+    a (b) blocks the segment only where it comes nearer the box than ORCA's disc (the clearance's
+    1 / :data:`CLEARANCE_FACTOR`), or than a (b) is if that is nearer: a character standing nearer a box
+    than the clearance may walk out of it or along it, but not where ORCA would not let it. (Blocked only
+    where it entered the box itself, a robot5 0.42 m from a crate's face was sent straight past it
+    0.12 m from its corner, which its 0.40 m disc cannot pass: it stood for 4 s, ``mixed``, seed 3005.
+    Blocked wherever it came nearer than a is, a quadruped spawned 0.5 m inside a looping box's grown
+    region was sent 1 m back, away from its goal, and stood, ``crates-moving``, seed 3000.)"""
+    body = clearance / CLEARANCE_FACTOR  # ORCA's disc
     for k in range(centres.shape[0]):
         cx = centres[k, 0]
         cz = centres[k, 1]
@@ -198,9 +214,19 @@ def _clear(ax, az, bx, bz, centres, half, cos_yaw, sin_yaw, clearance, own_a, ow
         hz = half[k, 1]
         c = cos_yaw[k]
         s = sin_yaw[k]
-        if (own_a and _inside(ax, az, cx, cz, hx, hz, c, s)) or (own_b and _inside(bx, bz, cx, cz, hx, hz, c, s)):
-            hx = max(hx - clearance, 0.0)
-            hz = max(hz - clearance, 0.0)
+        grow = clearance
+        if own_a and _inside(ax, az, cx, cz, hx, hz, c, s):
+            grow = min(grow, body, _depth_margin(ax, az, cx, cz, hx, hz, c, s, clearance) - NODE_EPS)
+        if own_b and _inside(bx, bz, cx, cz, hx, hz, c, s):
+            grow = min(grow, body, _depth_margin(bx, bz, cx, cz, hx, hz, c, s, clearance) - NODE_EPS)
+        if grow < 0.0:
+            # An end inside the box itself (a route point or a character in a looping box's region):
+            # the box does not block the way to or from it (blocked, no way existed, and the
+            # character aimed straight at its route point through the other boxes too).
+            continue
+        if grow < clearance:
+            hx = max(hx - clearance + max(grow, 0.0), 0.0)
+            hz = max(hz - clearance + max(grow, 0.0), 0.0)
         if _segment_enters(ax, az, bx, bz, cx, cz, hx, hz, c, s):
             return False
     return True

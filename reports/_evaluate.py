@@ -98,7 +98,7 @@ def violations(summary: dict, scenario: str) -> dict[str, int]:
 def replay_command(run: dict) -> str:
     return (f"footfall simulate {run['scenario']} --creature {run['creature']} --seed {run['seed']} "
             f"--characters {run['characters']} --frames {run['frames']} --lod {run['lod']}"
-            f"{' --navigate' if run.get('navigate') else ''} --json")
+            f"{'' if run.get('navigate', True) else ' --no-navigate'} --json")
 
 
 def run_one(task: dict) -> dict:
@@ -114,11 +114,11 @@ def run_one(task: dict) -> dict:
     gait, _, _ = resolve_gait(scenario if own else None, creature)
     model, summary, recorder = recorded_run(scenario, creature, gait, frames=task["frames"],
                                             characters=task["characters"], seed=task["seed"], lod=task["lod"],
-                                            navigate=bool(task.get("navigate")),
+                                            navigate=bool(task.get("navigate", True)),
                                             record=bool(task.get("picture")))
     s = summary.to_json()
     out = {**{k: task[k] for k in ("scenario", "creature", "seed", "characters", "frames", "lod")},
-           "navigate": bool(task.get("navigate")),
+           "navigate": bool(task.get("navigate", True)),
            "summary": s, "violations": violations(s, task["scenario"])}
     if recorder is not None:
         a = recorder.arrays
@@ -140,7 +140,7 @@ def draw_seeds(seeds: int, seed_base: int | None) -> list[int]:
 
 
 def evaluate(scenarios, creatures, seeds: list[int], *, characters: int, frames: int, lod: str,
-             workers: int | None = None, cluster: str | None = None, progress=None, navigate: bool = False) -> dict:
+             workers: int | None = None, cluster: str | None = None, progress=None, navigate: bool = True) -> dict:
     """Run every scenario x creature x seed; the ``--json`` result plus the runs. ``navigate``:
     ``ControllerConfig.navigate`` for every run."""
     from footfall._distribute import run_tasks

@@ -7,7 +7,7 @@ from pathlib import Path
 
 
 def recorded_run(scenario, creature, gait, *, frames: int, characters: int | None = None, seed: int = 0,
-                 preset=None, lod: str = "off", record: bool = True, progress=None, navigate: bool = False):
+                 preset=None, lod: str = "off", record: bool = True, progress=None, navigate: bool = True):
     """Simulate ``frames`` frames of the scenario's crowd; returns (model, summary, recorder or None).
 
     ``preset``: a loaded :class:`planner.Preset` (its weights and timing), or None for the defaults.
@@ -35,12 +35,11 @@ def say_speed_cap(model) -> None:
               f"{model.speed_cap:.3g} m/s, the fastest its legs carry at the stride law", file=sys.stderr)
 
 
-def recording_meta(scenario, seed: int, lod: str, gait, navigate: bool = False) -> dict:
+def recording_meta(scenario, seed: int, lod: str, gait, navigate: bool = True) -> dict:
     """What a recording's header says about its run, beside the recorder's own fields (``navigate``:
-    only when on, so the recordings of default runs keep their header)."""
-    meta = {"scenario": scenario.name, "seed": int(seed), "lod": lod, "gait": gait.name}
-    if navigate:
-        meta["navigate"] = True
+    ``ControllerConfig.navigate``, on by default since 2026-11-26; a header without it was recorded
+    before, without the way round)."""
+    meta = {"scenario": scenario.name, "seed": int(seed), "lod": lod, "gait": gait.name, "navigate": bool(navigate)}
     if not scenario.source.startswith("builtin:"):  # a user's scenario file: where to find it again
         meta["scenario_file"] = str(Path(scenario.source).resolve())
     return meta

@@ -96,7 +96,7 @@ def plan_batch(*args, **kwargs):
     crowd.plan_batch = planned
     return planned(*args, **kwargs)
 crowd.plan_batch = plan_batch
-main(["simulate", "mixed", "--frames", "3", "--characters", "4", "--navigate", "--json"])  # the way's kernels too
+main(["simulate", "mixed", "--frames", "3", "--characters", "4", "--json"])  # the way's kernels too (on by default)
 """
 
 

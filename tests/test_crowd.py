@@ -461,6 +461,34 @@ def test_two_feet_planned_in_one_frame_never_share_a_spot_whether_of_one_charact
     assert _same_frame_conflicts(model, cs, apart, valid).tolist() == [False, False, False, False]
 
 
+def test_two_legs_of_one_character_planned_in_one_frame_with_crossing_lines_conflict():
+    """Of two plans of one character whose ground lines (hip at touchdown to target) cross, the later
+    waits a frame: planned together, a turning spider's two rear left legs were given targets whose
+    lines crossed, and the legs were drawn crossed mid-swing (mixed, 3 spiders, seed 5, LOD zoomed).
+    Lines that only meet at an end, lines of two characters, or a pair with one plan invalid do not."""
+    from footfall.planner._crowd import _same_frame_conflicts, _segments_cross
+
+    scenario, creature = load_scenario("flat"), load_creature("spider")
+    model, _ = init_crowd(scenario, creature, load_gait(default_gait_name("spider"), creature), n_characters=2,
+                          seed=0, lod_mode="off", raster=_raster(scenario, creature))
+    # Hips 0.1 m apart on x; plan 1's line runs from the right hip to the left of plan 0's target:
+    # an X. Plan 2 (character 1) draws the same X over plan 0; plan 3 (character 0) runs parallel.
+    hips = np.array([[0.0, 0.0], [0.1, 0.0], [0.1, 0.0], [0.3, 0.0]])
+    targets = np.array([[0.1, 0.0, 0.3], [-0.1, 0.0, 0.3], [-0.1, 0.0, 0.5], [0.4, 0.0, 0.3]])
+    cs = np.array([0, 0, 1, 0])
+    valid = np.ones(4, np.bool_)
+    assert _same_frame_conflicts(model, cs, targets, valid, hips).tolist() == [False, True, False, False]
+    assert _same_frame_conflicts(model, cs, targets, valid).tolist() == [False, False, False, False]  # no hips
+    assert _same_frame_conflicts(model, cs, targets, np.array([False, True, True, True]), hips).tolist() == [
+        False, False, False, False]
+    # Crossing, touching at an end, parallel, one's end on the other's middle (a T): by hand.
+    p0, p1 = np.array([[0.0, 0.0]] * 4), np.array([[1.0, 1.0]] * 4)
+    q0 = np.array([[0.0, 1.0], [1.0, 1.0], [0.0, 0.5], [0.5, 0.5]])
+    q1 = np.array([[1.0, 0.0], [2.0, 0.0], [1.0, 1.5], [1.0, 0.0]])
+    assert _segments_cross(p0, p1, q0, q1).tolist() == [True, False, False, False]
+    assert _segments_cross(q0, q1, p0, p1).tolist() == [True, False, False, False]
+
+
 def test_a_stance_leg_carried_across_another_leg_steps():
     # Two neighbouring stance feet of a standing spider swapped (as a body turning over its feet
     # carries them): their drawn legs cross, and the controller asks both to step now (kind 2, a

@@ -64,8 +64,12 @@ def test_a_character_inside_a_grown_box_walks_out_and_a_walled_target_is_aimed_a
     path = shortest_way(way, (-0.8, 0.1), (3.0, 0.1))
     e = 1.0 + NODE_EPS
     np.testing.assert_allclose(path[1:-1], [[-e, e], [e, e]], atol=1e-12)
-    # Beside the box, its way to a target further along the face is straight.
-    assert shortest_way(way, (-0.8, 0.7), (3.0, 0.7)).shape == (2, 2)
+    # Beside the box, 0.3 m off its face, its way to a target further along the face is straight ...
+    assert shortest_way(way, (-0.8, 0.1), (-0.8, 3.0)).shape == (2, 2)
+    # ... but not to one past the corner along a line 0.2 m off the next face: nearer the box than the
+    # character is, where ORCA's disc (the clearance's 1 / 1.2) could not pass; it rounds the grown corner.
+    path = shortest_way(way, (-0.8, 0.7), (3.0, 0.7))
+    np.testing.assert_allclose(path[1:-1], [[-e, e], [e, e]], atol=1e-12)
     # A target inside a closed ring of boxes: no way; the aim is the target itself.
     ring = way_around(np.array([[0.0, 2.0], [0.0, -2.0], [2.0, 0.0], [-2.0, 0.0]]),
                       np.array([[5.0, 1.0], [5.0, 1.0], [1.0, 5.0], [1.0, 5.0]]), np.zeros(4), 0.3)
@@ -118,6 +122,60 @@ def test_random_ways_enter_no_grown_box_and_are_no_longer_than_a_detour_bound(se
         np.testing.assert_array_equal(aims[0], path[1], err_msg=f"seed {seed}")
 
 
+def _margins(points, centres, sizes, yaws):
+    """(P, B) m: how far each point is outside each box itself along the box's axes (the larger of the
+    two; 0 inside), computed here from the boxes' poses, not by the module."""
+    rel = points[:, None, :] - centres[None, :, :]
+    c, s = np.cos(yaws)[None, :], np.sin(yaws)[None, :]
+    u = c * rel[..., 0] + s * rel[..., 1]
+    v = -s * rel[..., 0] + c * rel[..., 1]
+    return np.maximum(np.maximum(np.abs(u) - 0.5 * sizes[None, :, 0], np.abs(v) - 0.5 * sizes[None, :, 1]), 0.0)
+
+
+@pytest.mark.parametrize("seed", fresh_seeds([0, 1, 2, 3], 2, salt=131))
+def test_a_way_from_near_a_box_never_comes_nearer_it_than_orcas_disc_or_the_start(seed):
+    """A character nearer a box than the clearance: no point of its way's first segment comes nearer that
+    box than ORCA's disc (the clearance / 1.2) or than the start itself, whichever is nearer; no point
+    of the way enters another grown box; and a target inside a box is reached straight when nothing
+    else is in the way. (Blocked only where it entered the box itself, a robot5 0.42 m from a crate
+    was sent past the crate's corner 0.12 m from it, which its 0.40 m disc cannot pass, and stood.)"""
+    from footfall.planner._navigation import CLEARANCE_FACTOR
+
+    rng = np.random.default_rng(seed)
+    b = int(rng.integers(1, 8))
+    centres = rng.uniform(-4.0, 4.0, (b, 2))
+    sizes = rng.uniform(0.2, 1.0, (b, 2))
+    yaws = rng.uniform(-math.pi, math.pi, b)
+    clearance = float(rng.uniform(0.2, 0.6))
+    body = clearance / CLEARANCE_FACTOR
+    way = way_around(centres, sizes, yaws, clearance)
+    checked = 0
+    for _ in range(40):
+        k = int(rng.integers(b))
+        # A start just off box k: on a random side, within the clearance.
+        p = centres[k] + rng.uniform(-1.0, 1.0, 2) * (0.5 * sizes[k].max() + clearance)
+        start = _margins(p[None], centres, sizes, yaws)[0]
+        if not (0.0 < start[k] < clearance) or (start < clearance)[np.arange(b) != k].any():
+            continue
+        q = rng.uniform(-6.0, 6.0, 2)
+        if (_margins(q[None], centres, sizes, yaws)[0] < clearance).any():
+            continue
+        path = shortest_way(way, p, q)
+        if path is None:
+            continue
+        checked += 1
+        t = np.linspace(0.0, 1.0, 201)[:, None]
+        first = path[0] + t * (path[1] - path[0])
+        near = _margins(first, centres, sizes, yaws)[:, k].min()
+        assert near >= min(body, start[k]) - 1e-6, f"seed {seed}: {path.tolist()} comes {near:.4f} m near box {k}"
+        rest = np.vstack([path[j] + t * (path[j + 1] - path[j]) for j in range(1, path.shape[0] - 1)] or [path[-1:]])
+        assert (_margins(rest, centres, sizes, yaws) >= clearance - 1e-6).all(), f"seed {seed}: {path.tolist()}"
+    assert checked >= 3, f"seed {seed}: only {checked} starts near a box"
+    # A target inside a box, nothing else in the way: straight there (no way existed before).
+    unit = way_around(*UNIT, 0.5)
+    assert shortest_way(unit, (-3.0, 0.1), (0.0, 0.0)).tolist() == [[-3.0, 0.1], [0.0, 0.0]]
+
+
 def test_bad_clearance_is_refused_naming_it():
     with pytest.raises(ValueError, match="clearance"):
         way_around(*UNIT, -1.0)
@@ -159,7 +217,7 @@ def _behind_a_crate(tmp_path, navigate: bool):
 def test_a_quadruped_whose_goal_lies_behind_a_forbidden_crate_walks_round_it(tmp_path):
     """The stuck case of the crowds issue's bar set, alone: a quadruped walking at a 2 m wide forbidden
     crate dead ahead, its goal straight behind it. Aimed round the crate it is well past it after 15 s;
-    steered straight at the goal (``ControllerConfig.navigate`` off, the default), ORCA slid it along the
+    steered straight at the goal (``ControllerConfig.navigate`` off; on by default), ORCA slid it along the
     crate's face and it is barely past (x 0.41; in crowds such characters stalled)."""
     from footfall.planner import simulate
 
@@ -197,18 +255,20 @@ def test_the_crowds_way_rounds_static_boxes_and_the_region_a_looping_box_sweeps(
     assert static_way_around(Obstacles.empty(), 0.25) is None
 
 
-def test_simulate_and_evaluate_take_navigate_and_the_replay_says_so(tmp_path):
+def test_simulate_and_evaluate_navigate_by_default_and_the_replay_says_when_not(tmp_path):
     import json
 
     from conftest import footfall_cli
     from footfall.reports._evaluate import replay_command
 
-    path = tmp_path / "run.npz"
-    done = footfall_cli("simulate", "crates", "--frames", "20", "--characters", "2", "--navigate", "--record", str(path),
-                        "--json")
-    assert done.returncode == 0, done.stderr
-    assert json.loads(done.stdout)["frames"] == 20
-    assert json.loads(str(np.load(path)["header"]))["navigate"] is True  # the recording says how it was run
+    for flags, on in (((), True), (("--navigate",), True), (("--no-navigate",), False)):
+        path = tmp_path / f"run{len(flags)}{on}.npz"
+        done = footfall_cli("simulate", "crates", "--frames", "20", "--characters", "2", *flags, "--record",
+                            str(path), "--json")
+        assert done.returncode == 0, done.stderr
+        assert json.loads(done.stdout)["frames"] == 20
+        assert json.loads(str(np.load(path)["header"]))["navigate"] is on  # the recording says how it was run
     run = dict(scenario="crates", creature="spider", seed=3, characters=6, frames=300, lod="off")
     assert replay_command(run).endswith("--lod off --json")
-    assert replay_command({**run, "navigate": True}).endswith("--lod off --navigate --json")
+    assert replay_command({**run, "navigate": True}).endswith("--lod off --json")
+    assert replay_command({**run, "navigate": False}).endswith("--lod off --no-navigate --json")
