@@ -329,6 +329,21 @@ def test_a_character_in_a_crates_lane_heads_square_out_of_it_to_the_nearer_side(
     assert not lane_exit(model, state, way)[1][0]
 
 
+def test_a_character_in_a_crates_lane_heads_for_its_top_speed_and_beside_it_for_the_asked_one(tmp_path):
+    # The crate and spider of the test above: in the lane, the steering heads for the spider's top
+    # speed (FLEE_SPEED of it), not the scenario's 0.3 m/s; beside the lane, for the asked 0.3 m/s.
+    from footfall.planner._crowd import FLEE_SPEED, _boxes_now, stage_steer
+
+    model, state = _world(tmp_path, "flee", crate_centre=(1.0, 0.0), crate_width=0.5, start=(0.0, 0.0),
+                          goal=(4.0, 0.0), velocity=(-0.2, 0.0))
+    assert FLEE_SPEED * model.top_speed > 0.3  # premise: the top speed is faster than the asked one
+    for z, goal in ((0.0, FLEE_SPEED * model.top_speed), (0.5 * 0.5 + model.rest_radius + 0.1, 0.3)):
+        state.pelvis[0, [0, 2]] = [0.0, z]
+        stage_steer(model, state, _boxes_now(model, state.t))
+        assert state.escaping[0] == (z == 0.0)
+        assert state.goal_speed[0] == pytest.approx(goal, abs=1e-12)
+
+
 def test_between_two_crates_lanes_the_way_out_leads_away_from_both(tmp_path):
     # Two 0.5 m crates drive -x at 0.2 m/s: A head-on at (1, 0), B passing beside the spider at (0, 0.6).
     # The spider stands at (0, 0.05), its way +x. A's nearer side is +z, B's is -z: summed, the two exits
@@ -526,6 +541,9 @@ def _escape_step_without_footprints(tmp_path, monkeypatch, escaping, prepare):
     original = crowd._plan_groups
     monkeypatch.setattr(crowd, "_lane_exit", lane_exit)
     monkeypatch.setattr(crowd, "_plan_groups", no_footprint)
+    # At the asked speed: asked for its flee speed from standing, another leg's look-ahead fails too
+    # (it cannot follow the body), and that foot, the worse, steps first: the case is the one foot.
+    monkeypatch.setattr(crowd, "FLEE_SPEED", 0.0)
     heading = float(state.heading[0])
     step(model, state)
     monkeypatch.undo()
