@@ -38,10 +38,6 @@ SAFETY = ("collisions", "forbidden_footprints", "leg_crossings", "body_overlaps"
 _HELD = ("a crate runs down a character whose body is held by a foot it cannot follow: tucked feet end in the crate"
          " (traced on crates-moving, spider)")
 _FEET_IN = "rendered feet inside crates (untraced)"
-_TOP = ("robot5: tucked feet inside a forbidden crate that runs alongside, the body already over its edge (seed"
-        " 1003, 120 foot-frames; on mixed, seeds 1100, 1102, 1105, 1200, 1202, 1208, all 549 foot-frames are tucked"
-        " feet of a robot5 escaping a crate, 193 with the body itself over it), and feet planned on a box top the"
-        " leg cannot reach (reach checked in xz only)")
 _CROSS = "adjacent legs cross while the body turns or is held and the gait swings a neighbour (untraced per seed)"
 _SLIP = ("a foot lands in the frame its body is held and its pose taken back: out of reach, it snaps on 2 frames later"
          " (traced on crates-moving, spider)")
@@ -85,23 +81,24 @@ _SWING_THROUGH = ("an ant's swing passes through the corner of a turned forbidde
                   " drawn path leaves the cells its wavefront kept (seed 1914251834, LOD off, character 2, leg 4,"
                   " frame 590, box 2; found by the fresh seed of session 30's CI, on code whose default runs that"
                   " session left bit for bit; why the path enters the cell is untraced)")
+# Since the way round static boxes became the default (2026-11-26), the fixed seeds of (mixed, spider) ran
+# clean of every promise, and those of (crates, spider), (crates-moving, spider) and (mixed, robot5) of
+# every promise but crossings: their entries went or kept only crossings (feet in boxes, overlaps and
+# slip had been known there).
 KNOWN: dict[tuple[str, str], dict[str, str]] = {
     ("crates", "ant"): {"collisions": _SWING_THROUGH, "leg_crossings": _SWINGS_CROSS},
     ("crates", "quadruped"): {"collisions": _CORNER, "leg_crossings": _FRONT_SWINGS},
     ("crates", "robot5"): {"collisions": _SHORT_ONTO_TOP, "leg_crossings": _CROSS, "stance_slip": _SLIP},
-    ("crates", "spider"): {"leg_crossings": _CROSS, "stance_slip": _SLIP},
+    ("crates", "spider"): {"leg_crossings": _CROSS},
     ("crates-moving", "ant"): {"collisions": _HELD, "leg_crossings": _CROSS, "body_overlaps": _GIVE_WAY,
                                "stance_slip": _SLIP},
     ("crates-moving", "quadruped"): {"collisions": _HELD, "leg_crossings": _CROSS, "body_overlaps": _GIVE_WAY},
     ("crates-moving", "robot5"): {"collisions": _HELD, "leg_crossings": _CROSS, "stance_slip": _SLIP,
                                   "shared_foot_spots": _LOST_FOOT, "ik_residual": _ASTRIDE},
-    ("crates-moving", "spider"): {"collisions": _HELD, "leg_crossings": _CROSS},
+    ("crates-moving", "spider"): {"leg_crossings": _CROSS},
     ("mixed", "ant"): {"collisions": _FEET_IN, "leg_crossings": _CROSS, "body_overlaps": _WALKS_INTO},
     ("mixed", "quadruped"): {"collisions": _QUAD_FOOT_IN, "leg_crossings": _CROSS},
-    ("mixed", "robot5"): {"collisions": _TOP, "leg_crossings": _CROSS, "stance_slip": _SLIP,
-                          "body_overlaps": _WALKS_INTO},
-    ("mixed", "spider"): {"collisions": _FEET_IN, "leg_crossings": _CROSS, "stance_slip": _SLIP,
-                          "body_overlaps": _WALKS_INTO},
+    ("mixed", "robot5"): {"leg_crossings": _CROSS},
     ("stairs", "ant"): {"leg_crossings": _CROSS, "stance_slip": _HIDDEN_SNAP},
     ("stairs", "robot5"): {"stance_slip": _HIDDEN_SNAP},
     ("stairs", "spider"): {"leg_crossings": _LIFT_OFF_CROSS},
