@@ -204,8 +204,8 @@ def _clear(ax, az, bx, bz, centres, half, cos_yaw, sin_yaw, clearance, own_a, ow
     than the clearance may walk out of it or along it, but not where ORCA would not let it. (Blocked only
     where it entered the box itself, a robot5 0.42 m from a crate's face was sent straight past it
     0.12 m from its corner, which its 0.40 m disc cannot pass: it stood for 4 s, ``mixed``, seed 3005.
-    Blocked wherever it came nearer than a is, a quadruped spawned 0.5 m inside a looping box's grown
-    region was sent 1 m back, away from its goal, and stood, ``crates-moving``, seed 3000.)"""
+    Blocked wherever it came nearer than a is, the crowds bar set's stuck time was 97 s against 71 s:
+    spiders on ``crates`` 21 s against 6, on ``crates-moving`` 26 against 10.)"""
     body = clearance / CLEARANCE_FACTOR  # ORCA's disc
     for k in range(centres.shape[0]):
         cx = centres[k, 0]
