@@ -1098,7 +1098,11 @@ def _same_frame_conflicts(model: CrowdModel, cs, targets, valid, hips=None) -> n
     if hips is not None:
         a, b = _same_character_pairs(cs, idx)
         if a.size:
-            crossed = _segments_cross(hips[a], targets[a][:, [0, 2]], hips[b], targets[b][:, [0, 2]])
+            from footfall.planner._kernels_geometry import segments_cross_rows
+
+            crossed = np.empty(a.size, np.bool_)
+            segments_cross_rows(np.ascontiguousarray(hips[a]), np.ascontiguousarray(targets[a][:, [0, 2]]),
+                                np.ascontiguousarray(hips[b]), np.ascontiguousarray(targets[b][:, [0, 2]]), crossed)
             conflict[b[crossed]] = True
     return conflict
 
@@ -1117,15 +1121,6 @@ def _same_character_pairs(cs, idx) -> tuple[np.ndarray, np.ndarray]:
         return np.zeros(0, np.int64), np.zeros(0, np.int64)
     a, b = np.concatenate(a_parts), np.concatenate(b_parts)
     return np.minimum(a, b), np.maximum(a, b)
-
-
-def _segments_cross(p0, p1, q0, q1) -> np.ndarray:
-    """(N,) bool: segments p0 -> p1 and q0 -> q1 ((N, 2) each) cross properly (each one's ends strictly
-    on both sides of the other's line)."""
-    def side(a, b, c):
-        return (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
-
-    return ((side(p0, p1, q0) * side(p0, p1, q1) < 0.0) & (side(q0, q1, p0) * side(q0, q1, p1) < 0.0))
 
 
 def _with_neighbours_feet(model: CrowdModel, state: CrowdState, cs, own, preferred, support):

@@ -191,6 +191,13 @@ def segments_cross(ax, az, bx, bz, cx, cz, dx, dz):
 
 
 @nb.njit(cache=True)
+def segments_cross_rows(p0, p1, q0, q1, out):
+    """``out[k]``: :func:`segments_cross` of rows k of segments p0 -> p1 and q0 -> q1 ((N, 2) x, z each)."""
+    for k in range(out.shape[0]):
+        out[k] = segments_cross(p0[k, 0], p0[k, 1], p1[k, 0], p1[k, 1], q0[k, 0], q0[k, 1], q1[k, 0], q1[k, 1])
+
+
+@nb.njit(cache=True)
 def rects_overlap(ax, az, ahx, ahz, ayaw, bx, bz, bhx, bhz, byaw):
     """Separating-axis test of two oriented rectangles (touching does not count)."""
     dx = bx - ax

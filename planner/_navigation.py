@@ -225,8 +225,8 @@ def _clear(ax, az, bx, bz, centres, half, cos_yaw, sin_yaw, clearance, own_a, ow
             # character aimed straight at its route point through the other boxes too).
             continue
         if grow < clearance:
-            hx = max(hx - clearance + max(grow, 0.0), 0.0)
-            hz = max(hz - clearance + max(grow, 0.0), 0.0)
+            hx = max(hx - clearance + grow, 0.0)
+            hz = max(hz - clearance + grow, 0.0)
         if _segment_enters(ax, az, bx, bz, cx, cz, hx, hz, c, s):
             return False
     return True

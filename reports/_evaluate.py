@@ -112,13 +112,13 @@ def run_one(task: dict) -> dict:
     creature = load_creature(task["creature"])
     own = task["creature"] == scenario.crowd.creature
     gait, _, _ = resolve_gait(scenario if own else None, creature)
+    navigate = bool(task.get("navigate", True))
     model, summary, recorder = recorded_run(scenario, creature, gait, frames=task["frames"],
                                             characters=task["characters"], seed=task["seed"], lod=task["lod"],
-                                            navigate=bool(task.get("navigate", True)),
-                                            record=bool(task.get("picture")))
+                                            navigate=navigate, record=bool(task.get("picture")))
     s = summary.to_json()
     out = {**{k: task[k] for k in ("scenario", "creature", "seed", "characters", "frames", "lod")},
-           "navigate": bool(task.get("navigate", True)),
+           "navigate": navigate,
            "summary": s, "violations": violations(s, task["scenario"])}
     if recorder is not None:
         a = recorder.arrays

@@ -466,7 +466,13 @@ def test_two_legs_of_one_character_planned_in_one_frame_with_crossing_lines_conf
     waits a frame: planned together, a turning spider's two rear left legs were given targets whose
     lines crossed, and the legs were drawn crossed mid-swing (mixed, 3 spiders, seed 5, LOD zoomed).
     Lines that only meet at an end, lines of two characters, or a pair with one plan invalid do not."""
-    from footfall.planner._crowd import _same_frame_conflicts, _segments_cross
+    from footfall.planner._crowd import _same_frame_conflicts
+    from footfall.planner._kernels_geometry import segments_cross_rows
+
+    def _segments_cross(p0, p1, q0, q1):
+        out = np.empty(p0.shape[0], np.bool_)
+        segments_cross_rows(p0, p1, q0, q1, out)
+        return out
 
     scenario, creature = load_scenario("flat"), load_creature("spider")
     model, _ = init_crowd(scenario, creature, load_gait(default_gait_name("spider"), creature), n_characters=2,
