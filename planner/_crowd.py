@@ -545,12 +545,11 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
     # Out of a moving box's lane faster than asked (FLEE_SPEED): an ant walking out of a 0.15 m/s
     # crate's lane at its asked 0.3 m/s was still in it when ORCA's velocity flipped and it stopped to
     # turn.
-    top = model.top_speed if math.isfinite(model.top_speed) else 0.0
-    flee = np.where(in_lane & ~arrived, FLEE_SPEED * top, 0.0)
-    preferred = direction * goal_speed[:, None]
-    velocity, avoided, among_others = _avoid(model, state, preferred, dist, boxes, box_velocity, in_lane, flee)
-    goal_speed = np.where(in_lane, np.maximum(goal_speed, flee), goal_speed)
+    if math.isfinite(model.top_speed):
+        goal_speed = np.where(in_lane & ~arrived, np.maximum(goal_speed, FLEE_SPEED * model.top_speed), goal_speed)
     state.goal_speed = goal_speed
+    preferred = direction * goal_speed[:, None]
+    velocity, avoided, among_others = _avoid(model, state, preferred, dist, boxes, box_velocity, in_lane)
     fast = np.hypot(velocity[:, 0], velocity[:, 1]) > 1e-6
     # Escaping a moving box's lane, ORCA's velocity can point back along the lane, away from the box:
     # as it crosses behind the character its angle flipped between +2.9 and -2.9 rad and the turn
@@ -645,7 +644,7 @@ FLEE_SPEED = 0.7
 is faster). Measured 2026-11-26, none -> 0.7 (-> 1.0): 40 runs of 8 ants and 8 spiders x 600 frames on
 ``crates-moving`` and ``mixed`` (seeds 1100-1109): foot-frames in boxes 517 -> 430 (268), crossing
 frames 8 -> 10 (4), overlaps 0; 1000 spiders x 300 frames on ``mixed``, LOD on, seeds 0-2: foot-frames
-in boxes 882 -> 768 (1049), overlapping pair-frames 99 -> 23 (44), crossing frames 322 -> 277 (259);
+in boxes 882 -> 769 (1049), overlapping pair-frames 99 -> 23 (44), crossing frames 322 -> 273 (259);
 the crowds bar set as before (stuck 71 -> 72 s, per-stride bars 96 -> 97 runs). Only for escapers with
 no neighbour near (ORCA's near): 517 -> 484 and 882 -> 897. Single runs move by tens of foot-frames
 either way (the escapes are chaotic: README, crowds and moving boxes)."""
@@ -815,13 +814,12 @@ def _time_to_contact(ways, speed, rel, box_velocity, u, side_axis, reach_along, 
 
 
 def _avoid(model: CrowdModel, state: CrowdState, preferred: np.ndarray, to_target: np.ndarray, boxes,
-           box_velocity: np.ndarray, escaping: np.ndarray, flee: np.ndarray | None = None):
+           box_velocity: np.ndarray, escaping: np.ndarray):
     """(velocity (C, 2), avoided (C,) bool, near (C,) bool): ORCA's velocity for every character, whether it
     differs from the preferred one (a neighbour or a box is in the way), and whether another character is
     within :data:`NEAR_RADII` avoid radii (among neighbours). ``boxes`` as
     :func:`_boxes_now` gives them, ``box_velocity`` from :func:`_box_velocities`; ``escaping`` (C,)
-    bool: characters leaving a moving box's lane, whom their neighbours make way for; ``flee`` (C,) m/s:
-    an escaping character prefers at least this speed (:data:`FLEE_SPEED`)."""
+    bool: characters leaving a moving box's lane, whom their neighbours make way for."""
     from footfall.planner._kernels_avoidance import neighbour_lists, orca_velocities
 
     n = state.pelvis.shape[0]
@@ -837,12 +835,6 @@ def _avoid(model: CrowdModel, state: CrowdState, preferred: np.ndarray, to_targe
         rows = np.repeat(np.arange(n), np.diff(start))
         gap = np.hypot(*(xz[index] - xz[rows]).T)
         near[rows[gap < NEAR_RADII * radius]] = True
-    if flee is not None:
-        run = escaping & (flee > 0.0)
-        if run.any():
-            norm = np.hypot(preferred[run, 0], preferred[run, 1])
-            preferred = preferred.copy()
-            preferred[run] *= (np.maximum(norm, flee[run]) / np.maximum(norm, 1e-12))[:, None]
     if near.any():
         c, s = math.cos(KEEP_RIGHT), math.sin(-KEEP_RIGHT)
         turn = near & (to_target > 1.0)
