@@ -77,8 +77,13 @@ def test_a_shipped_terrain_preset_beats_the_defaults_at_home_and_loses_nowhere()
                 assert p["cells"][terrain]["style"][first]["gain_se"] >= WIN_SE, (name, terrain)
 
 
-@pytest.mark.parametrize("name", ["spider-stairs", "quadruped-stairs", "ant-crates", "spider-mixed", "spider-cautious",
-                                  "spider-surefooted", "spider-direct"])
+def _every_preset():
+    from footfall.tuning._matrix import PRESETS
+
+    return list(PRESETS)
+
+
+@pytest.mark.parametrize("name", _every_preset())
 def test_a_shipped_preset_differs_from_the_defaults_and_records_its_tune(name):
     from footfall.planner import ScoringWeights
     from footfall.tuning._matrix import PRESETS

@@ -62,6 +62,8 @@ PRESETS = {
     "quadruped-stairs": {"creature": "quadruped", "terrain": "stairs",
                          "command": "footfall tune --creature quadruped --scenarios stairs,crates "
                                     "--out tuning/data/presets/quadruped-stairs.json"},
+    "ant-stairs": {"creature": "ant", "terrain": "stairs",
+                   "command": "footfall tune --creature ant --scenarios stairs --out tuning/data/presets/ant-stairs.json"},
     "ant-crates": {"creature": "ant", "terrain": "crates",
                    "command": "footfall tune --creature ant --scenarios crates --out tuning/data/presets/ant-crates.json"},
     "spider-mixed": {"creature": "spider", "terrain": "mixed",
