@@ -75,6 +75,9 @@ PRESETS = {
     "spider-surefooted": {"creature": "spider", "style": "tuning/data/styles/sure-footed.toml", "terrains": ("stairs",),
                           "command": "footfall tune --creature spider --scenarios stairs --targets "
                                      "tuning/data/styles/sure-footed.toml --out tuning/data/presets/spider-surefooted.json"},
+    "quadruped-surefooted": {"creature": "quadruped", "style": "tuning/data/styles/sure-footed.toml", "terrains": ("stairs",),
+                             "command": "footfall tune --creature quadruped --scenarios stairs --targets "
+                                        "tuning/data/styles/sure-footed.toml --out tuning/data/presets/quadruped-surefooted.json"},
     "spider-direct": {"creature": "spider", "style": "tuning/data/styles/direct.toml", "terrains": ("crates", "mixed"),
                       "command": "footfall tune --creature spider --scenarios crates,mixed --targets "
                                  "tuning/data/styles/direct.toml --out tuning/data/presets/spider-direct.json"},
