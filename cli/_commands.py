@@ -114,7 +114,31 @@ def scenarios_cmd() -> None:
         owner = gait_owner.get(gait)
         description = load_gait(gait, load_creature(owner)).description if owner else ""
         lines.append(f"  {gait:30} {owner or '':10} {description}")
+    lines.append("Presets (--preset NAME, or a .json; the terrain and style ones passed tuning/data/matrix.json):")
+    lines.extend(f"  {name:30} {creature:10} {what}" for name, creature, what in shipped_presets())
     _stdout().print("\n".join(lines), markup=False, soft_wrap=True, highlight=False)
+
+
+def shipped_presets() -> list[tuple[str, str, str]]:
+    """(name, creature, what it is for) of every shipped preset (``tuning/data/presets``): a creature's
+    generic preset, or a terrain or style preset of ``tuning._matrix.PRESETS`` (read without JAX)."""
+    from pathlib import Path
+
+    from footfall.tuning import PRESETS_DIR
+    from footfall.tuning._matrix import PRESETS
+
+    rows = []
+    for path in sorted(PRESETS_DIR.glob("*.json")):
+        spec = PRESETS.get(path.stem)
+        if spec is None:
+            creature = json.loads(path.read_text())["creature"]
+            rows.append((path.stem, creature, "generic: the gait timing fit to the stride law (flat ground, hills)"))
+        elif "terrain" in spec:
+            rows.append((path.stem, spec["creature"], f"terrain: {spec['terrain']}"))
+        else:
+            style = Path(spec["style"]).stem
+            rows.append((path.stem, spec["creature"], f"style: {style} ({spec['style']}) on {', '.join(spec['terrains'])}"))
+    return rows
 
 
 @app.command("check")
