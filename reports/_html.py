@@ -278,6 +278,8 @@ def matrix_section(matrix: dict | None) -> str:
                 if s["default"] is not None:
                     text += f"<br>{html.escape(s['metric'])} {s['default']:.3g} &rarr; {s['preset']:.3g} ({_se(s['gain_se'])})"
             text += f"<br>collisions {c['collisions_default']} &rarr; {c['collisions_preset']}"
+            if "crossings_default" in c:  # matrices proved before 2026-11-26 have none
+                text += f", leg crossings {c['crossings_default']} &rarr; {c['crossings_preset']}"
             cells.append(f"<td>{text}</td>")
         verdict = "yes" if p.get("passes") else "no: " + html.escape("; ".join(p.get("why", [])))
         parts.append(f"<tr><td>{html.escape(name)}</td>{''.join(cells)}<td>{verdict}</td>"

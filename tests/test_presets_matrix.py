@@ -68,6 +68,7 @@ def test_a_shipped_terrain_preset_beats_the_defaults_at_home_and_loses_nowhere()
         spec = PRESETS[name]
         for terrain, cell in p["cells"].items():
             assert not cell["collisions_rise"], (name, terrain)
+            assert not cell["crossings_rise"], (name, terrain)
             if "terrain" in spec:
                 bound = WIN_SE if terrain == spec["terrain"] else -LOSS_SE
                 assert cell["main"]["gain_se"] >= bound, (name, terrain, cell["main"])

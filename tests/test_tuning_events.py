@@ -286,8 +286,9 @@ def test_acceptance_needs_a_paired_gain_beyond_the_noise_and_no_more_collisions(
 # --------------------------------------------------------------------------- the matrix's rules
 
 
-def _events(values, key="stride_error", collisions=0, **other):
-    runs = [{key: v, "collisions": collisions if i == 0 else 0, **{k: o[i] for k, o in other.items()}}
+def _events(values, key="stride_error", collisions=0, crossings=0, **other):
+    runs = [{key: v, "collisions": collisions if i == 0 else 0, "leg_crossings": crossings if i < 2 else 0,
+             **{k: o[i] for k, o in other.items()}}
             for i, v in enumerate(values)]
     return {"runs": runs, "collisions": collisions}
 
@@ -316,6 +317,14 @@ def test_a_terrain_preset_passes_only_with_a_win_at_home_and_no_loss_elsewhere()
     collided = evaluate_cell(default, _events(better_values, collisions=1), {})  # one run with a collision
     assert collided["collisions_rise"]
     assert not verdict("spider-stairs", {"stairs": collided}, {}, 0.5)[0]
+    # Two runs with crossing frames where the defaults' runs had none: refused, and it says why.
+    crossed = evaluate_cell(default, _events(better_values, crossings=3), {})
+    assert crossed["crossings_rise"] and (crossed["crossings_default"], crossed["crossings_preset"]) == (0, 6)
+    assert verdict("spider-stairs", {"stairs": crossed}, {}, 0.5) == (
+        False, ["stairs: leg crossings rise 0 -> 6 frames"])
+    # The same crossings under both: no rise.
+    both = evaluate_cell(_events(base, crossings=3), _events(better_values, crossings=3), {})
+    assert not both["crossings_rise"] and verdict("spider-stairs", {"stairs": both}, {}, 0.5)[0]
 
 
 def test_a_style_preset_passes_when_its_metric_moves_toward_its_bound():

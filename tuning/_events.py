@@ -75,7 +75,7 @@ CLEARANCE_CAP_H = 10.0
 LOG_FLOOR = 1e-6
 NEAR_SHARE_REF = 0.05
 """A share of touch-downs near a box that costs as much as a stride error of one tolerance."""
-EVENT_METRICS = ("stride_error", "speed_ratio", "holds_per_100_steps", "stuck_s_per_100_steps", "collisions",
+EVENT_METRICS = ("stride_error", "speed_ratio", "holds_per_100_steps", "stuck_s_per_100_steps", "collisions", "leg_crossings",
                  "curvature_p95", "touchdown_slope_rad", "touchdown_roughness_m", "clearance_p05_h", "near_box_share",
                  "distance_ratio")
 STYLE_METRIC = {"min_clearance_body_heights": "near_box_share", "curvature_p95_max": "curvature_p95",
@@ -241,6 +241,7 @@ def run_event_task(task: dict) -> dict:
         "holds_per_100_steps": 100.0 * summary["holds"] / steps,
         "stuck_s_per_100_steps": 100.0 * summary["stuck_seconds"] / steps,
         "collisions": int(summary["collisions"]) + int(summary["body_overlaps"]),
+        "leg_crossings": int(summary["leg_crossings"]),
         "curvature_p95": float(np.percentile(curvature, 95)) if curvature.size else 0.0,
         "touchdown_slope_rad": float(np.mean(slope)) if slope.size else 0.0,
         "touchdown_roughness_m": float(np.mean(rough)) if rough.size else 0.0,
@@ -339,10 +340,11 @@ the foot-frame counts are rare, chaotic events carried by a few runs, so a stric
 defaults' refused on noise."""
 
 
-def collisions_rise(default: dict, other: dict) -> tuple[bool, float, float]:
-    """(rises, mean, SE) of other's runs with collisions - default's ([collisions > 0]), paired run by run."""
-    x = np.array([r["collisions"] > 0 for r in default["runs"]], dtype=np.float64)
-    y = np.array([r["collisions"] > 0 for r in other["runs"]], dtype=np.float64)
+def collisions_rise(default: dict, other: dict, key: str = "collisions") -> tuple[bool, float, float]:
+    """(rises, mean, SE) of other's runs with collisions - default's ([collisions > 0]), paired run by run;
+    ``key``: another count of rare events per run read the same way (``leg_crossings``: the matrix)."""
+    x = np.array([r[key] > 0 for r in default["runs"]], dtype=np.float64)
+    y = np.array([r[key] > 0 for r in other["runs"]], dtype=np.float64)
     d = y - x
     mean = float(d.mean()) if d.size else 0.0
     se = float(d.std(ddof=1) / math.sqrt(d.size)) if d.size > 1 else 0.0

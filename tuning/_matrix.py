@@ -15,7 +15,8 @@ A preset **passes** (``footfall bench presets`` says so, and only a passing pres
 * a style preset: on each terrain it was tuned for, its first style metric moves >= :data:`WIN_SE`
   toward its bound;
 * both: no rise of collisions and body overlaps over the defaults' in any cell
-  (:func:`tuning._events.collisions_rise`), and some weight differs from its default by at least
+  (:func:`tuning._events.collisions_rise`), nor of leg crossings (the share of runs with a crossing
+  frame, read the same way), and some weight differs from its default by at least
   :data:`MIN_WEIGHT_CHANGE`.
 
 Regenerate a preset with its ``command`` (:data:`PRESETS`), then the matrix with
@@ -123,9 +124,14 @@ def _repo_path(relative: str) -> Path:
 def evaluate_cell(default: dict, preset: dict, style: dict) -> dict:
     """One cell from the default's and the preset's event metrics of the same runs."""
     rises, mean, se = collisions_rise(default, preset)
+    crossed, crossed_mean, crossed_se = collisions_rise(default, preset, "leg_crossings")
     cell = {"main": _paired(default, preset, MAIN_METRIC, 1.0),
             "collisions_default": default["collisions"], "collisions_preset": preset["collisions"],
-            "collisions_rise": rises, "collisions_change_per_run": mean, "collisions_change_se": se, "style": {}}
+            "collisions_rise": rises, "collisions_change_per_run": mean, "collisions_change_se": se,
+            "crossings_default": int(sum(r["leg_crossings"] for r in default["runs"])),
+            "crossings_preset": int(sum(r["leg_crossings"] for r in preset["runs"])),
+            "crossings_rise": crossed, "crossings_change_per_run": crossed_mean, "crossings_change_se": crossed_se,
+            "style": {}}
     for key in style:
         metric = STYLE_METRIC[key]
         # Toward the bound: up for a lower bound (clearance, distance ratio), down for a ceiling.
@@ -137,7 +143,7 @@ def evaluate_cell(default: dict, preset: dict, style: dict) -> dict:
 def cell_runs(default: dict, preset: dict, style: dict) -> list[dict]:
     """The cell's runs one by one: which run (spawn, seed) and the metrics its cell is made of, under
     the defaults and under the preset (stored in the matrix, so a test can replay any run of it)."""
-    keys = (MAIN_METRIC, "collisions") + tuple(STYLE_METRIC[k] for k in style)
+    keys = (MAIN_METRIC, "collisions", "leg_crossings") + tuple(STYLE_METRIC[k] for k in style)
     return [{"spawn": d["spawn"], "seed": d["seed"], "default": {k: d[k] for k in keys},
              "preset": {k: p[k] for k in keys}}
             for d, p in zip(default["runs"], preset["runs"], strict=True)]
@@ -153,6 +159,8 @@ def verdict(name: str, cells: dict, style: dict, weight_change: float) -> tuple[
     for terrain, cell in cells.items():
         if cell["collisions_rise"]:
             why.append(f"{terrain}: collisions rise {cell['collisions_default']} -> {cell['collisions_preset']}")
+        if cell["crossings_rise"]:
+            why.append(f"{terrain}: leg crossings rise {cell['crossings_default']} -> {cell['crossings_preset']} frames")
     if "terrain" in spec:
         own = spec["terrain"]
         for terrain, cell in cells.items():
