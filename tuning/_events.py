@@ -24,6 +24,7 @@ Per run (:data:`EVENT_METRICS`):
 * ``speed_ratio``: ``speed_reached`` / min(asked, cap);
 * ``holds_per_100_steps``, ``stuck_s_per_100_steps``: ``holds`` and ``stuck_seconds`` per 100 ``steps``;
 * ``collisions``: ``collisions`` + ``body_overlaps`` (feet in boxes, bodies in bodies: held at 0);
+* ``leg_crossings``: the summary's crossing frames (not in the run loss; the preset matrix's guard);
 * ``curvature_p95``: 95th percentile of the plans' raw curvature energy (``RAW_CURVATURE``);
 * ``touchdown_slope_rad``, ``touchdown_roughness_m``: mean over the plans of the slope and the
   roughness under the footprint, from the plan's goodnesses and the run's reference scales
