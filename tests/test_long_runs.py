@@ -81,6 +81,10 @@ _SWING_THROUGH = ("an ant's swing passes through the corner of a turned forbidde
                   " drawn path leaves the cells its wavefront kept (seed 1914251834, LOD off, character 2, leg 4,"
                   " frame 590, box 2; found by the fresh seed of session 30's CI, on code whose default runs that"
                   " session left bit for bit; why the path enters the cell is untraced)")
+_SWING_CLIPS_WALL = ("a spider's swing passes a forbidden 0.1 m wall 8 cm above the ground with its foot's rectangle"
+                     " overlapping the wall's side, for a frame, as planned (drawn = planned: seed 594871979, LOD"
+                     " zoomed, character 4, leg 0, frame 584, box 4, mid-swing; found by the fresh seed of session 32's"
+                     " CI, on a runtime that session did not change; why the path passes there is untraced)")
 # Since the way round static boxes became the default (2026-11-26), the fixed seeds of (mixed, spider) ran
 # clean of every promise, and those of (crates, spider), (crates-moving, spider) and (mixed, robot5) of
 # every promise but crossings: their entries keep only crossings (feet in boxes, overlaps and slip had
@@ -96,7 +100,7 @@ KNOWN: dict[tuple[str, str], dict[str, str]] = {
     ("crates-moving", "quadruped"): {"collisions": _HELD, "leg_crossings": _CROSS, "body_overlaps": _GIVE_WAY},
     ("crates-moving", "robot5"): {"collisions": _HELD, "leg_crossings": _CROSS, "stance_slip": _SLIP,
                                   "shared_foot_spots": _LOST_FOOT, "ik_residual": _ASTRIDE},
-    ("crates-moving", "spider"): {"leg_crossings": _CROSS},
+    ("crates-moving", "spider"): {"collisions": _SWING_CLIPS_WALL, "leg_crossings": _CROSS},
     ("mixed", "ant"): {"collisions": _FEET_IN, "leg_crossings": _CROSS, "body_overlaps": _WALKS_INTO},
     ("mixed", "quadruped"): {"collisions": _QUAD_FOOT_IN, "leg_crossings": _CROSS},
     ("mixed", "robot5"): {"leg_crossings": _CROSS},
@@ -124,7 +128,7 @@ FIXED_SEEDS: dict[tuple[str, str, str], tuple[int, ...]] = {
     ("crates-moving", "robot5", "off"): (900, 901, 1000, 1001, 1002, 1003, 1004, 3458258, 1481763854),
     ("crates-moving", "robot5", "zoomed"): (900, 901, 1000, 1001, 1002, 1004, 1005),
     ("crates-moving", "spider", "off"): (900, 901, 1000, 1002, 1003, 1004, 1005),
-    ("crates-moving", "spider", "zoomed"): (900, 901, 1000, 1001, 1002, 1003, 1004, 1005),
+    ("crates-moving", "spider", "zoomed"): (900, 901, 1000, 1001, 1002, 1003, 1004, 1005, 594871979),
     ("mixed", "ant", "off"): (900, 901, 1000, 1001, 1003, 1102),
     ("mixed", "ant", "zoomed"): (900, 1000, 1001, 1002, 1003, 1004, 1005),
     ("mixed", "quadruped", "off"): (901,),
