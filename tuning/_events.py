@@ -76,8 +76,8 @@ CLEARANCE_CAP_H = 10.0
 LOG_FLOOR = 1e-6
 NEAR_SHARE_REF = 0.05
 """A share of touch-downs near a box that costs as much as a stride error of one tolerance."""
-EVENT_METRICS = ("stride_error", "speed_ratio", "holds_per_100_steps", "stuck_s_per_100_steps", "collisions", "leg_crossings",
-                 "curvature_p95", "touchdown_slope_rad", "touchdown_roughness_m", "clearance_p05_h", "near_box_share",
+EVENT_METRICS = ("stride_error", "speed_ratio", "holds_per_100_steps", "stuck_s_per_100_steps", "collisions",
+                 "leg_crossings", "curvature_p95", "touchdown_slope_rad", "touchdown_roughness_m", "clearance_p05_h", "near_box_share",
                  "distance_ratio")
 STYLE_METRIC = {"min_clearance_body_heights": "near_box_share", "curvature_p95_max": "curvature_p95",
                 "min_distance_ratio": "distance_ratio", "max_touchdown_slope_rad": "touchdown_slope_rad"}
