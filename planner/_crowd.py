@@ -550,6 +550,18 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
     state.goal_speed = goal_speed
     preferred = direction * goal_speed[:, None]
     velocity, avoided, among_others = _avoid(model, state, preferred, dist, boxes, box_velocity, in_lane)
+    # An escaper whose ORCA velocity heads somewhere worse than its way, looked ahead against the boxes,
+    # follows its way where that keeps it clear of the others (planner._escape: ORCA's velocity is
+    # holonomic; for a body that walks along its heading it flipped from ahead to behind as a crate closed in).
+    rows = np.flatnonzero(in_lane & avoided & (goal_speed > 0.0))
+    if rows.size:
+        from footfall.planner._escape import clear_of_others, orca_worse
+
+        rows = rows[orca_worse(model, state, rows, direction[rows], velocity[rows], goal_speed[rows],
+                               escape_boxes(boxes))]
+        rows = rows[clear_of_others(model, state, rows, preferred[rows])]
+        velocity[rows] = preferred[rows]
+        avoided[rows] = False
     fast = np.hypot(velocity[:, 0], velocity[:, 1]) > 1e-6
     # Escaping a moving box's lane, ORCA's velocity can point back along the lane, away from the box:
     # as it crosses behind the character its angle flipped between +2.9 and -2.9 rad and the turn
@@ -666,6 +678,25 @@ def _half_extents_along(half: np.ndarray, yaws: np.ndarray, axis: np.ndarray) ->
             + half[:, 1] * np.abs(-sin * axis[:, 0] + cos * axis[:, 1]))
 
 
+def flee_speed(model: CrowdModel, state: CrowdState, rows: np.ndarray) -> np.ndarray:
+    """(R,) m/s: the speed characters ``rows`` ask for leaving a moving box's lane (stage_steer's goal speed
+    for an escaper: :data:`FLEE_SPEED` x the top speed, or the asked speed if that is faster)."""
+    if not math.isfinite(model.top_speed):
+        return state.desired_speed[rows]
+    return np.maximum(state.desired_speed[rows], FLEE_SPEED * model.top_speed)
+
+
+def escape_boxes(boxes, moving: np.ndarray | None = None) -> np.ndarray:
+    """(B,) bool: the boxes an escaper keeps clear of: the forbidden static ones and the moving ones
+    (``moving``: only these indices of them). ``boxes`` as :func:`_boxes_now` gives them."""
+    used = boxes[3] & ~boxes[4]
+    if moving is None:
+        used |= boxes[4]
+    else:
+        used[moving] = True
+    return used
+
+
 def _lane_exit(model: CrowdModel, state: CrowdState, direction: np.ndarray, boxes, box_velocity: np.ndarray):
     """(direction (C, 2), in_lane (C,)): each character's way, turned out of the lanes of the moving
     boxes slower than its top speed that will reach its feet (its rest radius and the threat margin) within
@@ -711,6 +742,7 @@ def _lane_exit(model: CrowdModel, state: CrowdState, direction: np.ndarray, boxe
         return direction, in_lane
     norm = np.hypot(exit_way[:, 0], exit_way[:, 1])
     turn = in_lane & (norm > 1e-9)
+    own_way = direction
     direction = direction.copy()
     direction[turn] = exit_way[turn] / norm[turn, None]
     # Between two lanes the exits can cancel: the sum of two crates' exits led a spider toward the one
@@ -745,7 +777,14 @@ def _lane_exit(model: CrowdModel, state: CrowdState, direction: np.ndarray, boxe
         # Ties keep the earlier candidate: the sum first, as with one box.
         best = np.argmax(contact, axis=1)
         direction[rows] = candidates[np.arange(rows.size), best]
-    return direction, turn
+    # The way out, followed ahead against where the boxes will be, is kept unless another heading does
+    # clearly better (planner._escape: the rule above ignores how long the body takes to turn).
+    from footfall.planner._escape import escape_ways
+
+    rows = np.flatnonzero(in_lane)
+    direction[rows] = escape_ways(model, state, rows, direction[rows], own_way[rows], flee_speed(model, state, rows),
+                                  escape_boxes(boxes, moving))
+    return direction, in_lane
 
 
 STATIC_CONTACT_STEP = 0.1

@@ -304,13 +304,15 @@ def test_a_crate_driven_head_on_at_a_walking_spider_is_evaded(tmp_path, walk, cr
     assert state.pelvis[0, 0] > 0.5, "the spider walks on past the crate"
 
 
-def test_a_character_in_a_crates_lane_heads_square_out_of_it_to_the_nearer_side(tmp_path):
+def test_a_character_in_a_crates_lane_heads_square_out_of_it_to_the_nearer_side(tmp_path, monkeypatch):
     # A 0.5 m crate at (1, 0) drives -x at 0.2 m/s at a spider standing at the origin (facing +x, its
     # way +x): the crate's front (0.75) reaches its feet (rest radius + threat margin, 0.38 m) in
     # 1.9 s, under 3 s, so its way turns square out of the lane. Dead
     # centre, it takes the side of its way's right (+z: the lane's side axis for a crate going -x is
     # (0, -1), and the way has no part along it, so the tie goes to +z); 0.1 m to -z, it takes -z.
     # Behind the crate, or beside its lane, the way is kept.
+    # The lane exit's own rule: the look-ahead (planner._escape, tests/test_escape.py) keeps its way.
+    monkeypatch.setattr("footfall.planner._escape.ESCAPE_KEEP", math.inf)
     from footfall.planner._crowd import _box_velocities, _boxes_now, _lane_exit
 
     def lane_exit(model, state, way):
@@ -344,12 +346,14 @@ def test_a_character_in_a_crates_lane_heads_for_its_top_speed_and_beside_it_for_
         assert state.goal_speed[0] == pytest.approx(goal, abs=1e-12)
 
 
-def test_between_two_crates_lanes_the_way_out_leads_away_from_both(tmp_path):
+def test_between_two_crates_lanes_the_way_out_leads_away_from_both(tmp_path, monkeypatch):
     # Two 0.5 m crates drive -x at 0.2 m/s: A head-on at (1, 0), B passing beside the spider at (0, 0.6).
     # The spider stands at (0, 0.05), its way +x. A's nearer side is +z, B's is -z: summed, the two exits
     # cancel and the way (+x, into A) was kept. Walking at 0.3 m/s (rest radius + threat margin, 0.38 m,
     # added to each crate's half width, 0.63 m): +x meets A in 0.74 s and is inside B's reach for 1.26 s;
     # +z stays inside B's reach for 3.15 s; -z leaves it in 0.27 s and meets A only after 1.85 s. So -z.
+    # The lane exit's own rule: the look-ahead (planner._escape, tests/test_escape.py) keeps its way.
+    monkeypatch.setattr("footfall.planner._escape.ESCAPE_KEEP", math.inf)
     from footfall.planner._crowd import _box_velocities, _boxes_now, _lane_exit
 
     crates = "".join(CRATE.format(centre=list(c), width=0.5, motion='motion = { kind = "velocity", velocity = [-0.2, 0.0] }')
@@ -367,7 +371,7 @@ def test_between_two_crates_lanes_the_way_out_leads_away_from_both(tmp_path):
 
 
 @pytest.mark.parametrize("gap, expected", [(0.05, [0.0, 1.0]), (1.0, [0.0, -1.0])])
-def test_a_lane_exit_walled_by_a_static_crate_takes_the_other_side(tmp_path, gap, expected):
+def test_a_lane_exit_walled_by_a_static_crate_takes_the_other_side(tmp_path, monkeypatch, gap, expected):
     # The first encounter's crate (0.5 m, from (1, 0) at -0.2 m/s) and a spider at (0, -0.1), its way +x:
     # the nearer side is -z. A static forbidden crate (0.4 m) stands beside it on that side, its face
     # ``gap`` beyond the spider's avoid radius r. Walking -z at 0.3 m/s it comes within r of that face
@@ -376,6 +380,8 @@ def test_a_lane_exit_walled_by_a_static_crate_takes_the_other_side(tmp_path, gap
     # The other side, +z, leaves the lane (0.63 m, from -0.1) in 2.43 s and meets the crate at 1.85 s
     # (its centre within 0.63 m along); the walled side scores 0.2 s (the first 0.1 s step within r).
     # So +z. With the face 1.0 m further (3.3 s), the wall is ORCA's business later: -z, as without it.
+    # The lane exit's own rule: the look-ahead (planner._escape, tests/test_escape.py) keeps its way.
+    monkeypatch.setattr("footfall.planner._escape.ESCAPE_KEEP", math.inf)
     from footfall.planner._crowd import _box_velocities, _boxes_now, _lane_exit
 
     spider = load_creature("spider")
@@ -605,7 +611,9 @@ def test_an_escape_whose_orca_velocity_points_back_turns_to_the_lane_exits_side(
     # back and forth on the spot while the crate came (34 foot-frames on the 1200-frame crates-moving
     # run). Alone, the spider turns to the exit's side and walks only as far along its heading as
     # that velocity goes (0: it points back). With a neighbour within four avoid radii, ORCA's
-    # velocity (which knows of it) leads: the spider turns toward it, to the other side.
+    # velocity (which knows of it) leads: the spider turns toward it, to the other side. (The lane exit's
+    # own rule and ORCA's velocity: the look-ahead, planner._escape, keeps both.)
+    monkeypatch.setattr("footfall.planner._escape.ESCAPE_KEEP", math.inf)
     import footfall.planner._crowd as crowd
     from footfall.planner._crowd import _boxes_now
 

@@ -33,15 +33,16 @@ _MIXED = load_scenario("mixed")
 _RASTER = {}
 
 
-def _crowd(mode, n, seed=0, lod=None):
-    if "mixed" not in _RASTER:
-        _RASTER["mixed"] = WorldRaster.build(_MIXED.terrain, _MIXED.obstacles, planner_config_for(_SPIDER).cell_size)
-    return init_crowd(_MIXED, _SPIDER, load_gait(default_gait_name("spider"), _SPIDER), n_characters=n, seed=seed,
-                      lod_mode=mode, raster=_RASTER["mixed"], lod=lod)
+def _crowd(mode, n, seed=0, lod=None, scenario="mixed"):
+    world = _MIXED if scenario == "mixed" else load_scenario(scenario)
+    if scenario not in _RASTER:
+        _RASTER[scenario] = WorldRaster.build(world.terrain, world.obstacles, planner_config_for(_SPIDER).cell_size)
+    return init_crowd(world, _SPIDER, load_gait(default_gait_name("spider"), _SPIDER), n_characters=n, seed=seed,
+                      lod_mode=mode, raster=_RASTER[scenario], lod=lod)
 
 
-def _work(mode, lod=None, n=12, frames=30):
-    model, state = _crowd(mode, n, lod=lod)
+def _work(mode, lod=None, n=12, frames=30, scenario="mixed"):
+    model, state = _crowd(mode, n, lod=lod, scenario=scenario)
     for _ in range(frames):
         step(model, state)
     return state
@@ -68,7 +69,14 @@ def test_far_characters_build_smaller_maps_expand_fewer_cells_and_skip_ccd():
     assert (on.lod_level == LEVEL_FAR).all()
     per_plan = {name: (on.counters[name] / on.counters["plans"], off.counters[name] / off.counters["plans"])
                 for name in ("map_cells_built", "cells_expanded", "couples_evaluated")}
-    assert per_plan["map_cells_built"][0] < 0.5 * per_plan["map_cells_built"][1], per_plan
+    # Map cells on `crates`, whose boxes stand still: a far character near a moving box plans at full
+    # resolution by design (near_moving_box), so on `mixed` the ratio moves with how many pass near one
+    # (0.496 on this crowd before the look-ahead escapes of 2026-11-27, 0.517 after: 8 more plans near
+    # the moving crates); the compact maps themselves are (35 / 61)^2 = 0.33 of the full ones.
+    still_off, still_on = _work("off", scenario="crates"), _work("on", far, scenario="crates")
+    assert (still_on.lod_level == LEVEL_FAR).all()
+    cells = [s.counters["map_cells_built"] / s.counters["plans"] for s in (still_on, still_off)]
+    assert cells[0] < 0.5 * cells[1], cells
     assert per_plan["cells_expanded"][0] < 0.7 * per_plan["cells_expanded"][1], per_plan
     assert per_plan["couples_evaluated"][0] < per_plan["couples_evaluated"][1], per_plan
     # CCD only where a pose is taken back (a stance leg that cannot follow); the rest is two-bone
