@@ -235,3 +235,17 @@ def test_clear_of_others_is_the_closest_approach_within_the_horizon(tmp_path):
     state.pelvis[1, [0, 2]] = [1.2, 0.0]
     assert not clear_of_others(model, state, rows, np.array([[1.0, 0.0]]))[0]
 
+
+
+@pytest.mark.parametrize("seed", fresh_seeds([0], 2, salt=332))
+def test_box_centres_over_many_times_are_the_poses_at_each(seed):
+    # Obstacles.centres_over (the look-ahead's box paths, waypoint loops included) against poses_at,
+    # one time at a time, bit for bit, at random times (negative ones too) on the built-in moving scenarios.
+    from footfall.scenarios import load_scenario
+
+    rng = np.random.default_rng(seed)
+    times = rng.uniform(-30.0, 120.0, 40)
+    for name in ("crates-moving", "mixed"):
+        obstacles = load_scenario(name).obstacles
+        one_by_one = np.stack([obstacles.poses_at(float(t))[0] for t in times])
+        np.testing.assert_array_equal(obstacles.centres_over(times), one_by_one, err_msg=f"{name}, seed {seed}")
