@@ -701,7 +701,8 @@ def _lane_exit(model: CrowdModel, state: CrowdState, direction: np.ndarray, boxe
     """(direction (C, 2), in_lane (C,)): each character's way, turned out of the lanes of the moving
     boxes slower than its top speed that will reach its feet (its rest radius and the threat margin) within
     :data:`LANE_HORIZON`: square out of the lane, to the side the character is on, keeping only the
-    part of its way that runs ahead of the box. ``boxes`` as :func:`_boxes_now` gives them,
+    part of its way that runs ahead of the box, then checked by looking ahead (planner._escape:
+    :func:`escape_ways`). ``boxes`` as :func:`_boxes_now` gives them,
     ``box_velocity`` from :func:`_box_velocities`."""
     n = state.pelvis.shape[0]
     centres, sizes, yaws, _, moving = boxes

@@ -257,7 +257,8 @@ def _rows_of_3(value: object) -> object:
 
 
 def _points_on_loop(points: np.ndarray, cumulative: np.ndarray, distances: np.ndarray) -> np.ndarray:
-    """(T, 3): :func:`_point_on_loop` for each of ``distances`` (T,), with the same operations."""
+    """(T, 3): the points ``distances`` (T,) m along the closed polyline ``points`` (wrapping, either
+    direction); ``cumulative``: the arc length at each point, the closing segment included."""
     length = cumulative[-1]
     s = np.mod(distances, length)
     s = np.where((s >= 0.0) & (s < length), s, 0.0)  # float modulo can round up to ``length``
@@ -273,14 +274,4 @@ def _points_on_loop(points: np.ndarray, cumulative: np.ndarray, distances: np.nd
 
 def _point_on_loop(points: np.ndarray, cumulative: np.ndarray, distance: float) -> np.ndarray:
     """The point ``distance`` m along the closed polyline ``points`` (wrapping, either direction)."""
-    length = cumulative[-1]
-    s = distance % length
-    if not 0.0 <= s < length:  # float modulo can round up to ``length``
-        s = 0.0
-    k = points.shape[0]
-    j = min(int(np.searchsorted(cumulative, s, side="right")) - 1, k - 1)
-    segment = cumulative[j + 1] - cumulative[j]
-    fraction = 0.0 if segment <= 0.0 else min(max((s - cumulative[j]) / segment, 0.0), 1.0)
-    start = points[j]
-    end = points[(j + 1) % k]
-    return start + fraction * (end - start)
+    return _points_on_loop(points, cumulative, np.array([distance], dtype=np.float64))[0]
