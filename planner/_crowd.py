@@ -553,15 +553,15 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
     # An escaper whose ORCA velocity heads somewhere worse than its way, looked ahead against the boxes,
     # follows its way where that keeps it clear of the others (planner._escape: ORCA's velocity is
     # holonomic; for a body that walks along its heading it flipped from ahead to behind as a crate closed in).
-    rows = np.flatnonzero(in_lane & avoided & (goal_speed > 0.0))
-    if rows.size:
+    escapers = np.flatnonzero(in_lane & avoided & (goal_speed > 0.0))
+    if escapers.size:
         from footfall.planner._escape import clear_of_others, orca_worse
 
-        rows = rows[orca_worse(model, state, rows, direction[rows], velocity[rows], goal_speed[rows],
-                               escape_boxes(boxes))]
-        rows = rows[clear_of_others(model, state, rows, preferred[rows])]
-        velocity[rows] = preferred[rows]
-        avoided[rows] = False
+        escapers = escapers[orca_worse(model, state, escapers, direction[escapers], velocity[escapers],
+                                       goal_speed[escapers], escape_boxes(boxes))]
+        escapers = escapers[clear_of_others(model, state, escapers, preferred[escapers])]
+        velocity[escapers] = preferred[escapers]
+        avoided[escapers] = False
     fast = np.hypot(velocity[:, 0], velocity[:, 1]) > 1e-6
     # Escaping a moving box's lane, ORCA's velocity can point back along the lane, away from the box:
     # as it crosses behind the character its angle flipped between +2.9 and -2.9 rad and the turn
