@@ -216,20 +216,16 @@ class Obstacles:
         t = finite_float(t, "t")
         memo = self._poses_memo
         if t not in memo:
-            centres = np.array(self.centres)
-            moving = self.motion_kind == VELOCITY
-            centres[moving] += t * self.velocities[moving]
-            for i in np.flatnonzero(self.motion_kind == WAYPOINTS):
-                centres[i] = _point_on_loop(self.waypoints[i], self._loop_lengths[i], self.waypoint_speed[i] * t)
+            centres = self.centres_over([t])[0]
             if len(memo) >= 8:
                 memo.clear()
             memo[t] = centres
         return memo[t].copy(), np.array(self.yaws)
 
     def centres_over(self, times) -> np.ndarray:
-        """Box centres (T, n, 3) at each of ``times`` (T,) s: :meth:`poses_at`'s rule for many times at
-        once (a character looking ahead asks for tens of times a frame; the memo keeps the few the
-        crowd asks for again).
+        """Box centres (T, n, 3) at each of ``times`` (T,) s, by :meth:`poses_at`'s rule (which this
+        computes; it has no memo: a character looking ahead asks for tens of times a frame, and
+        :meth:`poses_at` memoises the few the crowd asks for again).
 
         Examples
         --------
@@ -270,8 +266,3 @@ def _points_on_loop(points: np.ndarray, cumulative: np.ndarray, distances: np.nd
     start = points[j]
     end = points[(j + 1) % k]
     return start + fraction[:, None] * (end - start)
-
-
-def _point_on_loop(points: np.ndarray, cumulative: np.ndarray, distance: float) -> np.ndarray:
-    """The point ``distance`` m along the closed polyline ``points`` (wrapping, either direction)."""
-    return _points_on_loop(points, cumulative, np.array([distance], dtype=np.float64))[0]

@@ -237,15 +237,24 @@ def test_clear_of_others_is_the_closest_approach_within_the_horizon(tmp_path):
 
 
 
-@pytest.mark.parametrize("seed", fresh_seeds([0], 2, salt=332))
-def test_box_centres_over_many_times_are_the_poses_at_each(seed):
-    # Obstacles.centres_over (the look-ahead's box paths, waypoint loops included) against poses_at,
-    # one time at a time, bit for bit, at random times (negative ones too) on the built-in moving scenarios.
-    from footfall.scenarios import load_scenario
+def test_box_centres_over_many_times_by_hand():
+    # Three boxes: static at (5, 0.1, 5); at 0.5 m/s along +x from the origin; looping at 1 m/s round the
+    # unit square (0,0) -> (1,0) -> (1,1) -> (0,1) -> back (4 m). At t = -0.5, 0.5, 1.5, 2.999, 4.25 the mover
+    # is at x = -0.25, 0.25, 0.75, 1.4995, 2.125 and the looper at (0, 0.5) (half a metre before closing the
+    # loop), (0.5, 0), (1, 0.5), (0.001, 1) (a millimetre before the square's last corner), (0.25, 0).
+    # poses_at gives each time's row.
+    from footfall.scenarios import Obstacles
 
-    rng = np.random.default_rng(seed)
-    times = rng.uniform(-30.0, 120.0, 40)
-    for name in ("crates-moving", "mixed"):
-        obstacles = load_scenario(name).obstacles
-        one_by_one = np.stack([obstacles.poses_at(float(t))[0] for t in times])
-        np.testing.assert_array_equal(obstacles.centres_over(times), one_by_one, err_msg=f"{name}, seed {seed}")
+    square = [[0.0, 0.1, 0.0], [1.0, 0.1, 0.0], [1.0, 0.1, 1.0], [0.0, 0.1, 1.0]]
+    boxes = Obstacles([[5.0, 0.1, 5.0], [0.0, 0.1, 0.0], [0.0, 0.1, 0.0]], [[0.2, 0.2, 0.2]] * 3, [0.0] * 3,
+                      [True] * 3, motion_kind=[0, 1, 2], velocities=[[0.0] * 3, [0.5, 0.0, 0.0], [0.0] * 3],
+                      waypoints=[np.zeros((0, 3)), np.zeros((0, 3)), square], waypoint_speed=[0.0, 0.0, 1.0])
+    times = [-0.5, 0.5, 1.5, 2.999, 4.25]
+    expected = np.array([[[5.0, 0.1, 5.0], [-0.25, 0.1, 0.0], [0.0, 0.1, 0.5]],
+                         [[5.0, 0.1, 5.0], [0.25, 0.1, 0.0], [0.5, 0.1, 0.0]],
+                         [[5.0, 0.1, 5.0], [0.75, 0.1, 0.0], [1.0, 0.1, 0.5]],
+                         [[5.0, 0.1, 5.0], [1.4995, 0.1, 0.0], [0.001, 0.1, 1.0]],
+                         [[5.0, 0.1, 5.0], [2.125, 0.1, 0.0], [0.25, 0.1, 0.0]]])
+    np.testing.assert_allclose(boxes.centres_over(times), expected, atol=1e-12)
+    for t, row in zip(times, expected):
+        np.testing.assert_allclose(boxes.poses_at(t)[0], row, atol=1e-12)
