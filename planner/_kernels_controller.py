@@ -257,6 +257,30 @@ def count_body_overlaps(centres, headings, half_length, half_width, out):
 
 
 @nb.njit(cache=True)
+def moves_into_bodies(centres, headings, moves, half_length, half_width, neighbour_start, neighbour_index, out):
+    """Per character c, True when its ground ``moves`` [c] makes its body box (half extents
+    ``half_length`` x ``half_width`` along its heading, about its pelvis) overlap a neighbour's
+    (CSR ``neighbour_start``, ``neighbour_index``) at the neighbour's place before the move, and
+    brings the two nearer."""
+    n = centres.shape[0]
+    for c in range(n):
+        out[c] = False
+        ax = centres[c, 0] + moves[c, 0]
+        az = centres[c, 1] + moves[c, 1]
+        for a in range(neighbour_start[c], neighbour_start[c + 1]):
+            d = neighbour_index[a]
+            bx = centres[d, 0]
+            bz = centres[d, 1]
+            before = (bx - centres[c, 0]) ** 2 + (bz - centres[c, 1]) ** 2
+            if (bx - ax) ** 2 + (bz - az) ** 2 >= before:
+                continue
+            if rects_overlap(ax, az, half_length, half_width, headings[c], bx, bz, half_length, half_width,
+                             headings[d]):
+                out[c] = True
+                break
+
+
+@nb.njit(cache=True)
 def count_close_pairs(points, owner, radius):
     """Pairs of points closer than ``radius`` (ground plane) that belong to different owners,
     through a uniform grid of cell ``radius`` (sorted cell keys), so it stays near linear."""

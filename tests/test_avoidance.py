@@ -230,3 +230,32 @@ def test_neighbour_lists_equal_brute_force_on_random_crowds(seed):
         within = np.flatnonzero((d[i] <= radius) & (np.arange(n) != i))
         nearest = within[np.argsort(d[i, within], kind="stable")[:k]]
         assert index[start[i]:start[i + 1]].tolist() == sorted(nearest.tolist()), f"seed {seed}, character {i}"
+
+
+def _moves_into(centres, headings, moves, half_length=0.1, half_width=0.05):
+    from footfall.planner._kernels_controller import moves_into_bodies
+
+    centres = np.asarray(centres, np.float64)
+    start, index = neighbour_lists(centres, 10.0)
+    out = np.empty(centres.shape[0], np.bool_)
+    moves_into_bodies(centres, np.asarray(headings, np.float64), np.asarray(moves, np.float64), half_length,
+                      half_width, start, index, out)
+    return out.tolist()
+
+
+def test_a_step_into_a_neighbours_body_is_refused_and_one_beside_or_away_is_not():
+    # Two bodies 0.2 x 0.1, both facing +x, 0.21 m apart along x: 1 cm of air between them.
+    centres, headings = [[0.0, 0.0], [0.21, 0.0]], [0.0, 0.0]
+    assert _moves_into(centres, headings, [[0.02, 0.0], [0.0, 0.0]]) == [True, False]  # 1 cm into it
+    assert _moves_into(centres, headings, [[0.005, 0.0], [0.0, 0.0]]) == [False, False]  # 5 mm of air left
+    assert _moves_into(centres, headings, [[-0.02, 0.0], [0.02, 0.0]]) == [False, False]  # both away
+    assert _moves_into(centres, headings, [[0.0, 0.02], [0.0, 0.0]]) == [False, False]  # sideways: farther
+    # Turned across (+z), the neighbour is 0.05 m deep along x instead of 0.1: 6 cm of air.
+    assert _moves_into(centres, [0.0, math.pi / 2], [[0.05, 0.0], [0.0, 0.0]]) == [False, False]
+    assert _moves_into(centres, [0.0, math.pi / 2], [[0.07, 0.0], [0.0, 0.0]]) == [True, False]
+
+
+def test_bodies_already_overlapping_may_part_but_not_press_further():
+    centres, headings = [[0.0, 0.0], [0.15, 0.0]], [0.0, 0.0]  # 5 cm into each other
+    assert _moves_into(centres, headings, [[0.01, 0.0], [0.0, 0.0]]) == [True, False]
+    assert _moves_into(centres, headings, [[-0.01, 0.0], [0.01, 0.0]]) == [False, False]

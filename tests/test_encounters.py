@@ -121,7 +121,8 @@ def test_a_crate_crossing_a_planned_swing_replans_it_the_same_frame(tmp_path, mo
     import footfall.planner._crowd as crowd
 
     monkeypatch.setattr(crowd, "_avoid", lambda model, state, preferred, *_: (
-        preferred, np.zeros(preferred.shape[0], np.bool_), np.zeros(preferred.shape[0], np.bool_)))
+        preferred, np.zeros(preferred.shape[0], np.bool_), np.zeros(preferred.shape[0], np.bool_),
+        (np.zeros(preferred.shape[0] + 1, np.int64), np.zeros(0, np.int64))))
 
     model, state = _world(tmp_path, "across-swing", crate_centre=(-1.1, -4.0), crate_width=0.2, start=(-2.0, 0.0),
                           goal=(4.0, 0.0), velocity=(0.0, 2.0))
@@ -215,13 +216,13 @@ def test_avoidance_keeps_a_forbidden_crate_clear_of_the_body_for_its_horizon(tmp
     r = model.avoid_radius
     assert 0.0 < d - r < 0.3 * AVOID_BOX_HORIZON, "the crate must be near enough to bind a 0.3 m/s walk"
     preferred = np.array([[0.3, 0.0]])
-    velocity, avoided, _ = _avoid(model, state, preferred, np.array([3.0]), boxes,
+    velocity, avoided, _, _ = _avoid(model, state, preferred, np.array([3.0]), boxes,
                                _box_velocities(model, state.t, boxes[0]), np.zeros(1, np.bool_))
     assert avoided[0]
     assert velocity[0, 0] <= (d - r) / AVOID_BOX_HORIZON + 1e-9
     assert velocity[0, 0] == pytest.approx((d - r) / AVOID_BOX_HORIZON, abs=1e-6)  # no slower than it must
     # Walking away from it: nothing to avoid.
-    velocity, avoided, _ = _avoid(model, state, -preferred, np.array([3.0]), boxes,
+    velocity, avoided, _, _ = _avoid(model, state, -preferred, np.array([3.0]), boxes,
                                _box_velocities(model, state.t, boxes[0]), np.zeros(1, np.bool_))
     assert not avoided[0] and velocity[0] == pytest.approx(-preferred[0])
 
@@ -249,7 +250,7 @@ def test_a_character_standing_still_is_avoided_with_the_whole_effort(tmp_path, m
 
     def a_velocity():
         # to_target under the keep-right distance: A's preferred velocity is its velocity.
-        velocity, avoided, _ = crowd._avoid(model, state, preferred, np.array([0.5, 0.5]), boxes, np.zeros((0, 2)),
+        velocity, avoided, _, _ = crowd._avoid(model, state, preferred, np.array([0.5, 0.5]), boxes, np.zeros((0, 2)),
                                          np.zeros(2, np.bool_))
         assert avoided[0]
         return velocity[0] - preferred[0]
@@ -629,7 +630,8 @@ def test_an_escape_whose_orca_velocity_points_back_turns_to_the_lane_exits_side(
 
     def back_to_the_other_side(*a, **k):
         side = np.sign(exits[-1][1])  # the exit's side along z (it squares out of a lane along x)
-        return np.array([[-0.2, -0.02 * side]]), np.array([True]), np.array([neighbour])
+        return (np.array([[-0.2, -0.02 * side]]), np.array([True]), np.array([neighbour]),
+                (np.zeros(2, np.int64), np.zeros(0, np.int64)))
 
     monkeypatch.setattr(crowd, "_lane_exit", recorded_exit)
     monkeypatch.setattr(crowd, "_avoid", back_to_the_other_side)
@@ -684,3 +686,53 @@ def test_the_lane_kernel_is_the_lane_rule_written_out_in_numpy(seed):
     assert threat[0, 0] and side[0, 0] == 1.0, "the dead-centre case is in the draw (its way leans to +z)"
     for name, mine, expected in zip(("threat", "side", "each_exit", "exit_way"), got, (threat, side, each_exit, exit_way)):
         np.testing.assert_array_equal(mine, expected, err_msg=f"seed {seed}: {name}")
+
+
+def test_a_walker_never_steps_into_a_body_in_its_way_even_where_its_velocity_would(tmp_path, monkeypatch):
+    # ORCA linearises each neighbour's velocity obstacle about the walker's velocity along its heading;
+    # a walker still turning toward its preferred velocity walked into a spider standing in its way
+    # (1000 spiders, mixed, seed 2: 122 overlapping frames). Here ORCA is stubbed to return the preferred
+    # velocity, straight at B: A stops where its next step would bring the two body boxes (0.25 x 0.15
+    # m, both facing +x; BODY_GAP_FRAMES frames at top speed apart) into each other, and not before.
+    import footfall.planner._crowd as crowd
+
+    path = tmp_path / "pair.toml"
+    path.write_text(WORLD.format(name="pair", crate=CRATE.format(centre=[5.0, 5.0], width=0.2, motion=""),
+                                 start=[0.0, 0.0], goal=[3.0, 0.0], speed=0.3))
+    creature = load_creature("spider")
+    real_avoid = crowd._avoid
+
+    def no_orca(model, state, preferred, *rest):
+        _, avoided, near, neighbours = real_avoid(model, state, preferred, *rest)
+        return preferred.copy(), np.zeros_like(avoided), near, neighbours
+
+    monkeypatch.setattr(crowd, "_avoid", no_orca)
+    boxes = (np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), np.zeros(0, np.bool_), np.zeros(0, np.bool_))
+
+    def a_step(air, pull=0.0):
+        """A's move along x, B's body ``air`` m beyond the grown contact, A walking at 0.3 m/s at B (or,
+        ``pull`` > 0, standing with its feet's feedback pulling it ``pull`` m toward B)."""
+        model, state = init_crowd(load_scenario(str(path)), creature, gait_schedule(creature), n_characters=2, seed=0)
+        grown = crowd.BODY_GAP_FRAMES * model.top_speed * model.dt
+        places = np.array([[0.0, 0.0], [0.25 + grown + air, 0.0]])
+        shift = places - state.pelvis[:, [0, 2]]
+        state.pelvis[:, [0, 2]] += shift
+        state.feet[:, :, [0, 2]] += shift[:, None, :]
+        state.heading[:] = 0.0
+        state.speed[:] = [0.0 if pull else 0.3, 0.0]
+        state.desired_speed[:] = [0.0 if pull else 0.3, 0.0]
+        state.body_held[:] = False
+        state.feedback[:] = [[pull, 0.0], [0.0, 0.0]]
+        before = state.pelvis[0, 0]
+        crowd.stage_steer(model, state, boxes)
+        return state.pelvis[0, 0] - before
+
+    step = a_step(0.05)
+    assert 0.002 < step < 0.05 * 0.5  # the premise: far enough, A walks on (a few mm a frame)
+    assert a_step(0.5 * step) == 0.0  # half a step of air left: A stops
+    assert a_step(1.5 * step) == pytest.approx(step, abs=1e-9)  # a step and a half: it takes its step
+    # The feet's pull (feedback, paper §3.2) moves no body into another either.
+    pull = 0.2  # well above the threshold (0.15 rest radius): moves the pelvis feedback_gain x dt of it
+    moved = a_step(0.05, pull)
+    assert 0.002 < moved < 0.05
+    assert a_step(0.5 * moved, pull) == 0.0
