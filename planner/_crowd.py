@@ -2001,8 +2001,13 @@ def avoid_radius(creature, rest_radius: float | None, positions: np.ndarray) -> 
     return float(np.clip(0.5 * 0.99 * gap, AVOID_RADIUS_MIN * radius, AVOID_RADIUS * radius))
 
 
+SPAWN_CLEAR_STEP = 0.1
+"""s: the step at which the places of the boxes over the crowd's ``spawn_clear_s`` are taken."""
+
+
 def spawn_positions(scenario, creature, n: int, spacing_factor: float = 2.1):
-    """n start positions (x, z) on a sunflower spiral around the crowd centre, clear of boxes.
+    """n start positions (x, z) on a sunflower spiral around the crowd centre, clear of the boxes
+    over the crowd's first ``spawn_clear_s`` (scenarios.CrowdSpawn).
 
     Creatures are ``spacing_factor`` x their crowd radius (:func:`crowd_radius`, the rest radius
     for most) apart; when the world is too small the spacing shrinks (down to one radius: legs
@@ -2012,7 +2017,11 @@ def spawn_positions(scenario, creature, n: int, spacing_factor: float = 2.1):
 
     rest = crowd_radius(creature)
     obs = scenario.obstacles
-    centres, _ = obs.poses_at(0.0)
+    # Where each box will be over the crowd's spawn_clear_s (3 s by default, the lane exit's horizon): a
+    # spider spawned 0.5 m before a crate coming at it spent its first second turning on the spot and was
+    # run over (1000 spiders, mixed, seed 0: 151 of the run's 322 foot-frames in boxes; 8 after).
+    horizon = scenario.crowd.spawn_clear_s
+    paths = obs.centres_over(np.arange(0.0, horizon + 1e-9, SPAWN_CLEAR_STEP)) if len(obs.yaws) else None
     box_r = 0.5 * np.hypot(obs.sizes[:, 0], obs.sizes[:, 2]) if len(obs.yaws) else np.zeros(0)
     x0, x1 = scenario.terrain.x_range
     z0, z1 = scenario.terrain.z_range
@@ -2027,9 +2036,9 @@ def spawn_positions(scenario, creature, n: int, spacing_factor: float = 2.1):
         inside = (pts[:, 0] > x0 + rest + 0.5) & (pts[:, 0] < x1 - rest - 0.5) & (pts[:, 1] > z0 + rest + 0.5) & (
             pts[:, 1] < z1 - rest - 0.5)
         clear = np.ones(m, np.bool_)
-        if len(box_r):
+        for centres in paths if paths is not None else ():
             d = np.hypot(pts[:, None, 0] - centres[None, :, 0], pts[:, None, 1] - centres[None, :, 2])
-            clear = (d > box_r[None, :] + rest + 0.1).all(axis=1)
+            clear &= (d > box_r[None, :] + rest + 0.1).all(axis=1)
         # The spiral's neighbours are only about `spacing` apart (its first two points 0.56 x):
         # keep a point only if it is at least `spacing` from every point kept before it.
         kept: list[int] = []

@@ -583,6 +583,7 @@ def load_scenario(name_or_path: str | Path) -> Scenario:
         goal=model.crowd.goal,
         waypoints=model.crowd.waypoints,
         feet_spacing=model.crowd.feet_spacing,
+        spawn_clear_s=model.crowd.spawn_clear_s,
         gait=None if model.crowd.gait is None else _crowd_gait(model.crowd.gait, creature, base, file),
     ))
     creature_radius = creature.rest_radius * crowd.feet_spacing

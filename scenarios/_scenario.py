@@ -50,6 +50,10 @@ class CrowdSpawn:
         gait ``.toml`` (loaders store it already resolved against the scenario file); pass to
         :func:`scenarios.load_gait` with the creature. None: the creature's gaits
         (its default, or its built-in schedule by speed).
+    spawn_clear_s : float
+        s, >= 0: creatures are spawned clear of where the boxes will be over this long (a moving box
+        that would reach a creature in its first seconds runs it over while it turns to go); 0: of
+        where they are at the start. Default 3.
 
     Examples
     --------
@@ -77,6 +81,7 @@ class CrowdSpawn:
     waypoints: np.ndarray | None = None
     feet_spacing: float = 1.0
     gait: str | None = None
+    spawn_clear_s: float = 3.0
 
     def __post_init__(self) -> None:
         if not isinstance(self.creature, str) or not self.creature.strip():
@@ -99,6 +104,10 @@ class CrowdSpawn:
         waypoints = np.zeros((0, 2)) if self.waypoints is None or np.size(self.waypoints) == 0 else self.waypoints
         object.__setattr__(self, "waypoints", frozen_array(waypoints, "waypoints", (None, 2)))
         object.__setattr__(self, "feet_spacing", positive_float(self.feet_spacing, "feet_spacing"))
+        spawn_clear_s = finite_float(self.spawn_clear_s, "spawn_clear_s")
+        if spawn_clear_s < 0.0:
+            raise invalid("spawn_clear_s", "must be >= 0")
+        object.__setattr__(self, "spawn_clear_s", spawn_clear_s)
 
     @property
     def route(self) -> np.ndarray:

@@ -141,6 +141,7 @@ class CrowdFile(_Model):
     waypoints: list[Vec2] = []
     feet_spacing: Positive = 1.0
     gait: Text | None = None
+    spawn_clear_s: NonNegative = 3.0
 
 
 class CameraFile(_Model):

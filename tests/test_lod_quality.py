@@ -59,6 +59,7 @@ centre = [0.0, 0.0]
 heading = 0.0
 speed = 0.2
 goal = [2.5, 0.0]
+spawn_clear_s = 0.0  # spawned where the crate will sweep through
 """
 
 

@@ -450,6 +450,7 @@ def test_minimal_file_loads(tmp_path):
         (lambda t: t.replace('"spider"', '"dragon"'), "crowd.creature"),  # unknown creature name
         (lambda t: t.replace('"spider"', '"bugs/dragon.toml"'), "crowd.creature"),
         (lambda t: t.replace("goal = [1.5, 0.0]", "goal = [9.0, 0.0]"), "crowd.goal"),
+        (lambda t: t.replace("goal = [1.5, 0.0]", "goal = [1.5, 0.0]\nspawn_clear_s = -1.0"), "crowd.spawn_clear_s"),
         (lambda t: t.split("[crowd]")[0], "crowd"),
         (lambda t: t + "x = = 1\n", "scenario"),  # TOML syntax
         (lambda t: t + "[[obstacles]]\ncentre = [-0.9, 0.0]\nsize = [0.2, 0.2, 0.2]\n", "obstacles[0].centre"),
