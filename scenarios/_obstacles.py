@@ -103,6 +103,9 @@ class Obstacles:
     # The last few poses asked for, by time: a crowd asks for the same few times several times a frame
     # (now, the last frame, the threat horizon), and a looping box's pose is a Python search.
     _poses_memo: dict = field(init=False, repr=False, compare=False)
+    # The looping boxes' loops padded to one array each (index, points, next points, arc lengths), so
+    # that every loop is walked at once (_points_on_loops).
+    _loops: tuple = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         centres = frozen_array(_rows_of_3(self.centres), "centres", (None, 3))
@@ -163,6 +166,7 @@ class Obstacles:
         object.__setattr__(self, "waypoint_speed", speeds)
         object.__setattr__(self, "_loop_lengths", tuple(loops))
         object.__setattr__(self, "_poses_memo", {})
+        object.__setattr__(self, "_loops", _padded_loops(np.flatnonzero(kind == WAYPOINTS), points, loops))
 
     @classmethod
     def empty(cls) -> Obstacles:
@@ -239,8 +243,9 @@ class Obstacles:
         centres = np.repeat(np.array(self.centres)[None], times.size, axis=0)
         moving = self.motion_kind == VELOCITY
         centres[:, moving] += times[:, None, None] * self.velocities[moving][None]
-        for i in np.flatnonzero(self.motion_kind == WAYPOINTS):
-            centres[:, i] = _points_on_loop(self.waypoints[i], self._loop_lengths[i], self.waypoint_speed[i] * times)
+        index = self._loops[0]
+        if index.size:
+            centres[:, index] = _points_on_loops(self._loops, self.waypoint_speed[index][None, :] * times[:, None])
         return centres
 
 
@@ -252,17 +257,37 @@ def _rows_of_3(value: object) -> object:
         return value
 
 
-def _points_on_loop(points: np.ndarray, cumulative: np.ndarray, distances: np.ndarray) -> np.ndarray:
-    """(T, 3): the points ``distances`` (T,) m along the closed polyline ``points`` (wrapping, either
-    direction); ``cumulative``: the arc length at each point, the closing segment included."""
-    length = cumulative[-1]
+def _padded_loops(index: np.ndarray, points, cumulative) -> tuple:
+    """(index (W,), points (W, K, 3), next points (W, K, 3), arc lengths (W, K + 1)) of the looping boxes
+    ``index``: each loop's waypoints padded to the longest loop's K, the point after each (wrapping),
+    and the arc length at each waypoint, the closing segment included, then +inf (so no padded
+    waypoint is ever passed)."""
+    k = max((points[i].shape[0] for i in index), default=1)
+    here = np.zeros((index.size, k, 3))
+    after = np.zeros((index.size, k, 3))
+    lengths = np.full((index.size, k + 1), np.inf)
+    for row, i in enumerate(index):
+        n = points[i].shape[0]
+        here[row, :n] = points[i]
+        after[row, :n] = np.roll(points[i], -1, axis=0)
+        lengths[row, :n + 1] = cumulative[i]
+    return readonly(np.array(index)), readonly(here), readonly(after), readonly(lengths)
+
+
+def _points_on_loops(loops: tuple, distances: np.ndarray) -> np.ndarray:
+    """(T, W, 3): the points ``distances`` (T, W) m along each of the W closed polylines of ``loops``
+    (:func:`_padded_loops`; wrapping, either direction)."""
+    _, here, after, lengths = loops
+    w = np.arange(here.shape[0])
+    length = lengths[w, (lengths < np.inf).sum(axis=1) - 1]  # (W,) each loop's whole length
     s = np.mod(distances, length)
     s = np.where((s >= 0.0) & (s < length), s, 0.0)  # float modulo can round up to ``length``
-    k = points.shape[0]
-    j = np.minimum(np.searchsorted(cumulative, s, side="right") - 1, k - 1)
-    segment = cumulative[j + 1] - cumulative[j]
+    # The waypoint each point follows: the inner waypoints it has passed (the closing one never is).
+    j = (lengths[None, :, 1:-1] <= s[..., None]).sum(axis=-1)  # (T, W)
+    start_s = lengths[w, j]
+    segment = lengths[w, j + 1] - start_s
     with np.errstate(divide="ignore", invalid="ignore"):
-        fraction = np.where(segment <= 0.0, 0.0, np.clip((s - cumulative[j]) / segment, 0.0, 1.0))
-    start = points[j]
-    end = points[(j + 1) % k]
-    return start + fraction[:, None] * (end - start)
+        fraction = np.where(segment <= 0.0, 0.0, np.clip((s - start_s) / segment, 0.0, 1.0))
+    start = here[w, j]
+    end = after[w, j]
+    return start + fraction[..., None] * (end - start)

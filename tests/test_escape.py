@@ -242,19 +242,24 @@ def test_box_centres_over_many_times_by_hand():
     # unit square (0,0) -> (1,0) -> (1,1) -> (0,1) -> back (4 m). At t = -0.5, 0.5, 1.5, 2.999, 4.25 the mover
     # is at x = -0.25, 0.25, 0.75, 1.4995, 2.125 and the looper at (0, 0.5) (half a metre before closing the
     # loop), (0.5, 0), (1, 0.5), (0.001, 1) (a millimetre before the square's last corner), (0.25, 0).
-    # poses_at gives each time's row.
+    # A fourth loops at 2 m/s round a triangle of three waypoints (loops of different lengths walked at
+    # once): (0,0) -> (3,0) -> (0,4) -> back (3 + 5 + 4 = 12 m), at 11, 1, 3 (its corner), 5.998 and 8.5 m:
+    # (0, 1), (1, 0), (3, 0), (3 - 3 x 0.5996, 4 x 0.5996), (0, 3.5). poses_at gives each time's row.
     from footfall.scenarios import Obstacles
 
     square = [[0.0, 0.1, 0.0], [1.0, 0.1, 0.0], [1.0, 0.1, 1.0], [0.0, 0.1, 1.0]]
-    boxes = Obstacles([[5.0, 0.1, 5.0], [0.0, 0.1, 0.0], [0.0, 0.1, 0.0]], [[0.2, 0.2, 0.2]] * 3, [0.0] * 3,
-                      [True] * 3, motion_kind=[0, 1, 2], velocities=[[0.0] * 3, [0.5, 0.0, 0.0], [0.0] * 3],
-                      waypoints=[np.zeros((0, 3)), np.zeros((0, 3)), square], waypoint_speed=[0.0, 0.0, 1.0])
+    triangle = [[0.0, 0.1, 0.0], [3.0, 0.1, 0.0], [0.0, 0.1, 4.0]]
+    boxes = Obstacles([[5.0, 0.1, 5.0], [0.0, 0.1, 0.0], [0.0, 0.1, 0.0], [0.0, 0.1, 0.0]], [[0.2, 0.2, 0.2]] * 4,
+                      [0.0] * 4, [True] * 4, motion_kind=[0, 1, 2, 2],
+                      velocities=[[0.0] * 3, [0.5, 0.0, 0.0], [0.0] * 3, [0.0] * 3],
+                      waypoints=[np.zeros((0, 3)), np.zeros((0, 3)), square, triangle],
+                      waypoint_speed=[0.0, 0.0, 1.0, 2.0])
     times = [-0.5, 0.5, 1.5, 2.999, 4.25]
-    expected = np.array([[[5.0, 0.1, 5.0], [-0.25, 0.1, 0.0], [0.0, 0.1, 0.5]],
-                         [[5.0, 0.1, 5.0], [0.25, 0.1, 0.0], [0.5, 0.1, 0.0]],
-                         [[5.0, 0.1, 5.0], [0.75, 0.1, 0.0], [1.0, 0.1, 0.5]],
-                         [[5.0, 0.1, 5.0], [1.4995, 0.1, 0.0], [0.001, 0.1, 1.0]],
-                         [[5.0, 0.1, 5.0], [2.125, 0.1, 0.0], [0.25, 0.1, 0.0]]])
+    expected = np.array([[[5.0, 0.1, 5.0], [-0.25, 0.1, 0.0], [0.0, 0.1, 0.5], [0.0, 0.1, 1.0]],
+                         [[5.0, 0.1, 5.0], [0.25, 0.1, 0.0], [0.5, 0.1, 0.0], [1.0, 0.1, 0.0]],
+                         [[5.0, 0.1, 5.0], [0.75, 0.1, 0.0], [1.0, 0.1, 0.5], [3.0, 0.1, 0.0]],
+                         [[5.0, 0.1, 5.0], [1.4995, 0.1, 0.0], [0.001, 0.1, 1.0], [3.0 - 3.0 * 0.5996, 0.1, 4.0 * 0.5996]],
+                         [[5.0, 0.1, 5.0], [2.125, 0.1, 0.0], [0.25, 0.1, 0.0], [0.0, 0.1, 3.5]]])
     np.testing.assert_allclose(boxes.centres_over(times), expected, atol=1e-12)
     for t, row in zip(times, expected):
         np.testing.assert_allclose(boxes.poses_at(t)[0], row, atol=1e-12)
