@@ -98,13 +98,11 @@ class Obstacles:
     velocities: np.ndarray | None = None
     waypoints: tuple[np.ndarray, ...] | None = None
     waypoint_speed: np.ndarray | None = None
-    # Per box with motion kind 2: cumulative arc length at each waypoint, closing segment included ((k + 1,)).
-    _loop_lengths: tuple[np.ndarray, ...] = field(init=False, repr=False)
     # The last few poses asked for, by time: a crowd asks for the same few times several times a frame
-    # (now, the last frame, the threat horizon), and a looping box's pose is a Python search.
+    # (now, the last frame, the threat horizon).
     _poses_memo: dict = field(init=False, repr=False, compare=False)
-    # The looping boxes' loops padded to one array each (index, points, next points, arc lengths), so
-    # that every loop is walked at once (_points_on_loops).
+    # The looping boxes' loops padded to one array each (index, points, next points, arc lengths at each
+    # waypoint, the closing segment included), so that every loop is walked at once (_points_on_loops).
     _loops: tuple = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -164,7 +162,6 @@ class Obstacles:
         object.__setattr__(self, "velocities", velocities)
         object.__setattr__(self, "waypoints", tuple(points))
         object.__setattr__(self, "waypoint_speed", speeds)
-        object.__setattr__(self, "_loop_lengths", tuple(loops))
         object.__setattr__(self, "_poses_memo", {})
         object.__setattr__(self, "_loops", _padded_loops(np.flatnonzero(kind == WAYPOINTS), points, loops))
 
