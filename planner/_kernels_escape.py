@@ -24,6 +24,8 @@ import math
 import numba as nb
 import numpy as np
 
+from footfall.planner._kernels_geometry import wrap_pi
+
 
 @nb.njit(cache=True)
 def _box_gap(px, pz, cx, cz, hx, hz, cos_yaw, sin_yaw):
@@ -33,11 +35,6 @@ def _box_gap(px, pz, cx, cz, hx, hz, cos_yaw, sin_yaw):
     along = abs(rx * cos_yaw + rz * sin_yaw) - hx
     across = abs(-rx * sin_yaw + rz * cos_yaw) - hz
     return math.hypot(max(along, 0.0), max(across, 0.0))
-
-
-@nb.njit(cache=True)
-def _wrap(a):
-    return (a + math.pi) % (2.0 * math.pi) - math.pi
 
 
 @nb.njit(cache=True)
@@ -88,9 +85,9 @@ def escape_costs(pelvis_xz, heading, speed, pace, targets, turn_step, accel_step
             cost = 0.0
             blocked = False
             for j in range(n_steps):
-                left = _wrap(targets[r, k] - h)
+                left = wrap_pi(targets[r, k] - h)
                 h += min(max(left, -turn_step), turn_step)
-                left = _wrap(targets[r, k] - h)
+                left = wrap_pi(targets[r, k] - h)
                 wanted = pace[r] * max(math.cos(min(max(left, -0.5 * math.pi), 0.5 * math.pi)), 0.0)
                 v += min(max(wanted - v, -accel_step), accel_step)
                 px += v * math.cos(h) * step

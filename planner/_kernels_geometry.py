@@ -166,6 +166,12 @@ def supercover_visit(ax, az, bx, bz, origin_x, origin_z, cell, rows_out, cols_ou
 
 
 @nb.njit(cache=True)
+def wrap_pi(x):
+    """``x`` (rad) wrapped into [-pi, pi)."""
+    return (x + math.pi) % (2.0 * math.pi) - math.pi
+
+
+@nb.njit(cache=True)
 def segment_point_distance(px, pz, ax, az, bx, bz):
     """Distance from point p to segment a-b in the plane."""
     dx = bx - ax

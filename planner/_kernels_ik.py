@@ -129,6 +129,8 @@ import math
 import numba as nb
 import numpy as np
 
+from footfall.planner._kernels_geometry import wrap_pi
+
 TWO_PI = 2.0 * math.pi
 EPS = 1e-12
 """Lengths (m) below this count as zero: the step is then undefined and skipped."""
@@ -173,12 +175,6 @@ def nearest_in_limits(x, lo, hi):
     if r - hi <= lo + TWO_PI - r:
         return hi
     return lo
-
-
-@nb.njit(cache=True)
-def _wrap_pi(x):
-    """``x`` wrapped into [-pi, pi)."""
-    return (x + math.pi) % TWO_PI - math.pi
 
 
 @nb.njit(cache=True, inline="always")
@@ -267,7 +263,7 @@ def _azimuth_for(fx, fy, q_az, df, du, dl, alpha, azimuth_limit, rolls):
         want = math.atan2(-side, -du)
         if fy > 0.0:
             want += math.pi
-        return nearest_in_limits(q_az + _wrap_pi(want - q_az), -azimuth_limit, azimuth_limit)
+        return nearest_in_limits(q_az + wrap_pi(want - q_az), -azimuth_limit, azimuth_limit)
     horizontal = math.hypot(df, dl)
     if horizontal < EPS or abs(fx) < EPS:
         return q_az
@@ -275,7 +271,7 @@ def _azimuth_for(fx, fy, q_az, df, du, dl, alpha, azimuth_limit, rolls):
     if fx < 0.0:
         want += math.pi
     # the wanted azimuth's representative nearest the current one, then the limits
-    return nearest_in_limits(q_az + _wrap_pi(want - q_az), -azimuth_limit, azimuth_limit)
+    return nearest_in_limits(q_az + wrap_pi(want - q_az), -azimuth_limit, azimuth_limit)
 
 
 @nb.njit(cache=True)
@@ -402,18 +398,18 @@ def _pair_step(b, i, j, lengths, limits, q, fx, fy, tx, ty, mirror, chain):
     best_j = old_j
     best = current
     best_motion = 0.0
-    bend = _wrap_pi(offset_v - offset_a - middle - old_j)  # current psi (see below)
+    bend = wrap_pi(offset_v - offset_a - middle - old_j)  # current psi (see below)
     for side in range(2):
         # psi: ccw angle of the virtual link relative to link A
         psi = spread if side == 0 else -spread
         if not mirror and psi * bend < 0.0:
             continue  # keep the triangle's orientation (no flip to the mirror pose)
         new_j = offset_v - offset_a - middle - psi
-        new_j = nearest_in_limits(old_j + _wrap_pi(new_j - old_j), limits[b, j, 0], limits[b, j, 1])
+        new_j = nearest_in_limits(old_j + wrap_pi(new_j - old_j), limits[b, j, 0], limits[b, j, 1])
         psi = offset_v - offset_a - middle - new_j
         kappa = math.atan2(v_len * math.sin(psi), a_len + v_len * math.cos(psi))
         new_i = offset_a + kappa - target_angle - phi_before
-        new_i = nearest_in_limits(old_i + _wrap_pi(new_i - old_i), limits[b, i, 0], limits[b, i, 1])
+        new_i = nearest_in_limits(old_i + wrap_pi(new_i - old_i), limits[b, i, 0], limits[b, i, 1])
         theta_a = offset_a - phi_before - new_i  # ccw direction of link A
         cx = px + a_len * math.cos(theta_a) + v_len * math.cos(theta_a + psi)
         cy = py + a_len * math.sin(theta_a) + v_len * math.sin(theta_a + psi)
