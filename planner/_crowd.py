@@ -2020,9 +2020,13 @@ def spawn_positions(scenario, creature, n: int, spacing_factor: float = 2.1):
     # Where each box will be over the crowd's spawn_clear_s (3 s by default, the lane exit's horizon): a
     # spider spawned 0.5 m before a crate coming at it spent its first second turning on the spot and was
     # run over (1000 spiders, mixed, seed 0: 151 of the run's 322 foot-frames in boxes; 8 after).
-    horizon = scenario.crowd.spawn_clear_s
-    paths = obs.centres_over(np.arange(0.0, horizon + 1e-9, SPAWN_CLEAR_STEP)) if len(obs.yaws) else None
-    box_r = 0.5 * np.hypot(obs.sizes[:, 0], obs.sizes[:, 2]) if len(obs.yaws) else np.zeros(0)
+    # A static box is where it starts at every one of those times: it is checked once.
+    spots = []  # (centres (B, 3), half diagonals (B,)) to keep clear of
+    if len(obs.yaws):
+        paths = obs.centres_over(np.arange(0.0, scenario.crowd.spawn_clear_s + 1e-9, SPAWN_CLEAR_STEP))
+        box_r = 0.5 * np.hypot(obs.sizes[:, 0], obs.sizes[:, 2])
+        still = np.asarray(obs.is_static)
+        spots = [(paths[0, still], box_r[still])] + [(centres, box_r[~still]) for centres in paths[:, ~still]]
     x0, x1 = scenario.terrain.x_range
     z0, z1 = scenario.terrain.z_range
     golden = math.pi * (3.0 - math.sqrt(5.0))
@@ -2036,9 +2040,9 @@ def spawn_positions(scenario, creature, n: int, spacing_factor: float = 2.1):
         inside = (pts[:, 0] > x0 + rest + 0.5) & (pts[:, 0] < x1 - rest - 0.5) & (pts[:, 1] > z0 + rest + 0.5) & (
             pts[:, 1] < z1 - rest - 0.5)
         clear = np.ones(m, np.bool_)
-        for centres in paths if paths is not None else ():
+        for centres, radii in spots:
             d = np.hypot(pts[:, None, 0] - centres[None, :, 0], pts[:, None, 1] - centres[None, :, 2])
-            clear &= (d > box_r[None, :] + rest + 0.1).all(axis=1)
+            clear &= (d > radii[None, :] + rest + 0.1).all(axis=1)
         # The spiral's neighbours are only about `spacing` apart (its first two points 0.56 x):
         # keep a point only if it is at least `spacing` from every point kept before it.
         kept: list[int] = []
