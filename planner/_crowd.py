@@ -862,6 +862,11 @@ def _time_to_contact(ways, speed, rel, box_velocity, u, side_axis, reach_along, 
     return np.minimum(when.min(axis=2), LANE_HORIZON)
 
 
+def _fastest(model: CrowdModel, state: CrowdState) -> float:
+    """m/s: the fastest a character can walk: the creature's top speed, or (none known) the fastest asked."""
+    return model.top_speed if math.isfinite(model.top_speed) else float(np.max(state.desired_speed, initial=0.0))
+
+
 def _avoid(model: CrowdModel, state: CrowdState, preferred: np.ndarray, to_target: np.ndarray, boxes,
            box_velocity: np.ndarray, escaping: np.ndarray):
     """(velocity (C, 2), avoided (C,) bool, near (C,) bool): ORCA's velocity for every character, whether it
@@ -874,7 +879,7 @@ def _avoid(model: CrowdModel, state: CrowdState, preferred: np.ndarray, to_targe
     n = state.pelvis.shape[0]
     xz = np.ascontiguousarray(state.pelvis[:, [0, 2]])
     radius = model.avoid_radius
-    top = model.top_speed if math.isfinite(model.top_speed) else float(np.max(state.desired_speed))
+    top = _fastest(model, state)
     # The lists reach at least NEAR_RADII avoid radii, so the nearest other character, if that near, is in
     # its character's list: 'near' below is 'another character within NEAR_RADII avoid radii'.
     start, index = neighbour_lists(xz, max(2.0 * radius + 2.0 * top * AVOID_HORIZON, NEAR_RADII * radius),
@@ -927,7 +932,7 @@ def bodies_apart(model: CrowdModel, state: CrowdState, move: np.ndarray, neighbo
     if index.size == 0:
         return np.ones(n, np.bool_)
     box = model.creature.body_box
-    top = model.top_speed if math.isfinite(model.top_speed) else float(np.max(state.desired_speed, initial=0.0))
+    top = _fastest(model, state)
     grow = 0.5 * BODY_GAP_FRAMES * top * model.dt
     into = np.empty(n, np.bool_)
     moves_into_bodies(np.ascontiguousarray(state.pelvis[:, [0, 2]]), np.ascontiguousarray(state.heading),
