@@ -162,3 +162,40 @@ def test_a_foot_under_a_box_faster_than_the_creature_is_an_unavoidable_contact()
     slow = FrameCounters(dataclasses.replace(model, top_speed=0.1), state)
     slow.update(state)
     assert (slow.collisions, slow.unavoidable_contacts) == (0, 1)
+
+
+def _stride_walk(speeds, strides):
+    """One foot of one character landing every 10 frames (dt 0.1 s) at the given strides (m), the body
+    at ``speeds[k]`` in frame k: the per-stride errors the meter measures."""
+    from types import SimpleNamespace
+
+    from footfall.planner._simulation import StrideMeter
+    from footfall.planner._timing import GaitTiming
+
+    model = SimpleNamespace(dt=0.1, timing=GaitTiming(), leg_height=0.12, speed_cap=np.inf)
+    state = SimpleNamespace(desired_speed=np.array([0.3]), feet=np.zeros((1, 1, 3)), pelvis=np.zeros((1, 3)),
+                            speed=np.zeros(1), in_stance=np.ones((1, 1), np.bool_), lod_level=None)
+    meter = StrideMeter(model, state)
+    landings = {10 * (i + 1): float(x) for i, x in enumerate(np.cumsum(strides))}
+    meter.update(0, SimpleNamespace(**{**vars(state), "speed": np.array([speeds[0]])}), np.ones((1, 1), np.bool_))
+    for k in range(1, len(speeds)):
+        state.speed = np.array([speeds[k]])
+        state.pelvis = state.pelvis + [[speeds[k] * model.dt, 0.0, 0.0]]
+        if k in landings:
+            state.feet = np.array([[[landings[k], 0.0, 0.0]]])
+        meter.update(k, state, np.full((1, 1), k in landings))
+    return meter.summary()
+
+
+def test_a_stride_through_a_dodge_is_not_measured_against_the_law():
+    from footfall.planner._timing import GaitTiming, stride_frequency
+
+    law = 0.3 / stride_frequency(GaitTiming(), 0.3, 0.12)  # the stride the law commands at 0.3 m/s
+    steady = [0.3] * 31
+    # three steady strides, 10 % long, exact, 20 % short: all measured
+    median, p90, n = _stride_walk(steady, [1.1 * law, law, 0.8 * law])
+    assert n == 3 and median == pytest.approx(0.1)
+    # the second stride through a dodge (0.3 -> 0.05 -> 0.3 m/s; both touch-downs at 0.3): not measured
+    dodge = steady[:13] + [0.05] * 4 + steady[17:]
+    median, p90, n = _stride_walk(dodge, [1.1 * law, law, 0.8 * law])
+    assert n == 2 and median == pytest.approx(0.15)

@@ -21,7 +21,7 @@ from footfall.planner._counters import CONTACT_TOLERANCE_M
 from footfall.planner._crowd import init_crowd
 from footfall.planner._kernels_controller import count_body_overlaps, count_collisions
 from footfall.planner._lod import LEVEL_HIDDEN, LEVEL_NAMES, LodConfig
-from footfall.planner._simulation import Recorder, simulate
+from footfall.planner._simulation import STEADY_BAND, Recorder, simulate
 from footfall.planner._timing import stride_frequency
 from footfall.reports._animation import joint_positions
 from footfall.reports._lod_report import level_rows
@@ -79,6 +79,7 @@ def _recompute(recording, creature, model, start, goal):
     pop, switches = 0.0, 0
     anchor = rendered[0].copy()
     last = {}  # (character, leg) -> (frame, foot xz, pelvis xz, speed) of its last landing
+    slowest, fastest = {}, {}  # (character, leg) -> the body's slowest / fastest speed since that landing
     obstacles = model.raster.obstacles
     body = creature.body_box
     for k in range(1, f + 1):
@@ -113,7 +114,11 @@ def _recompute(recording, creature, model, start, goal):
             row["body_overlaps"] += int(overlaps[ch])
             if drawn[ch]:
                 row["residuals"].extend(np.linalg.norm(r[ch] - planned[k, ch], axis=-1))
-        # Steady strides (planner._simulation.StrideMeter): touch-down to touch-down of one foot.
+        # Steady strides (planner._simulation.StrideMeter): touch-down to touch-down of one foot,
+        # the body's speed within STEADY_BAND of the stride's mean speed at every frame of it.
+        for key in last:
+            slowest[key] = min(slowest[key], recording.speed[was, key[0]])
+            fastest[key] = max(fastest[key], recording.speed[was, key[0]])
         for ch, leg in zip(*np.nonzero(landed)):
             foot = planned[k, ch, leg, [0, 2]]
             pelvis = recording.pelvis[was, ch, [0, 2]]
@@ -122,11 +127,13 @@ def _recompute(recording, creature, model, start, goal):
                 k0, foot0, pelvis0, speed0 = last[ch, leg]
                 v = np.linalg.norm(pelvis - pelvis0) / ((k - k0) * model.dt)
                 g = goal[ch]
-                if 0.5 * g <= speed0 <= 1.5 * g and 0.5 * g <= speed <= 1.5 * g and v > 0:
+                if (0.5 * g <= speed0 <= 1.5 * g and 0.5 * g <= speed <= 1.5 * g and v > 0
+                        and (1.0 - STEADY_BAND) * v <= slowest[ch, leg] and fastest[ch, leg] <= (1.0 + STEADY_BAND) * v):
                     stride = np.linalg.norm(foot - foot0)
                     f_v = float(stride_frequency(model.timing, np.array([v]), model.leg_height)[0])
                     out[int(level[k, ch])]["errors"].append(abs(stride * f_v / v - 1.0))
             last[ch, leg] = (k, foot, pelvis, speed)
+            slowest[ch, leg] = fastest[ch, leg] = speed
     return out, pop, switches
 
 
