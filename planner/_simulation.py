@@ -5,9 +5,12 @@ Metrics are measured after each frame and are not part of the frame time:
   measured on the rendered pose by :class:`planner._counters.FrameCounters` (see there);
 * ``forbidden_footprints``: landings touching a forbidden box;
 * ``stride_rel_error_median`` / ``_p90``: per stride (one foot's consecutive touch-downs),
-  |lambda_i / lambda*(v_i) - 1|, lambda_i the ground distance between the two footprints, v_i
+  |lambda_i / (s_i lambda*(v_i)) - 1|, lambda_i the ground distance between the two footprints, v_i
   the pelvis's ground speed between them, lambda*(v) = v / f(v) the stride the timing model
-  commands (the target law lambda = c h Fr^e wherever the stride frequency is above its floor);
+  commands (the target law lambda = c h Fr^e wherever the stride frequency is above its floor),
+  s_i the foot's own share of the body's travel: how far its rest point (:func:`rest_points`)
+  travelled between the touch-downs over how far the pelvis did (1 on a straight stride; in a turn
+  the outer feet stride further, the inner ones less, at the one tempo of the gait);
   steady strides only: both touch-downs at between half and 1.5 times the character's goal
   speed (min(asked, speed_cap)), not in the start-up or the stop at the goal, and the body's
   speed within STEADY_BAND of v_i at every frame of the stride (``strides_measured``): the law
@@ -30,7 +33,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from footfall._atomic import atomic_path
-from footfall.planner._crowd import STAGES, CrowdModel, CrowdState, step
+from footfall.planner._crowd import STAGES, CrowdModel, CrowdState, _rot_xz, step
 from footfall.planner._counters import FrameCounters
 from footfall.planner._weights import N_TERMS
 
@@ -339,6 +342,23 @@ def asked_speed(model: CrowdModel, state: CrowdState) -> np.ndarray:
     return np.minimum(state.desired_speed, model.speed_cap)
 
 
+def rest_points(model: CrowdModel, pelvis_xz, heading, spacing, legs) -> np.ndarray:
+    """(n, 2) m, where legs ``legs`` of bodies at ``pelvis_xz`` facing ``heading`` with feet spacing
+    ``spacing`` have their rest feet on the ground (x, z).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from types import SimpleNamespace
+    >>> model = SimpleNamespace(rest_body=np.array([[0.2, 0.1]]))   # 0.2 m ahead, 0.1 m to the left
+    >>> rest_points(model, np.zeros((1, 2)), np.array([np.pi / 2]), np.ones(1), np.array([0])).round(3)
+    array([[-0.1,  0.2]])
+    """
+    rest = model.rest_body[legs] * np.asarray(spacing)[:, None]
+    x, z = _rot_xz(np.asarray(heading), rest[:, 0], rest[:, 1])
+    return np.asarray(pelvis_xz) + np.stack([x, z], axis=1)
+
+
 STEADY_BAND = 0.2
 """A measured stride's body speed stays within this fraction of its mean speed at every frame (module
 doc). Only touch-downs were checked before: 9 of 16 crowded runs (crates, crates-moving, mixed; 6
@@ -356,6 +376,7 @@ class StrideMeter:
         self.last_frame = np.full((c, l), -1, np.int64)
         self.last_foot = np.zeros((c, l, 2))
         self.last_pelvis = np.zeros((c, l, 2))
+        self.last_rest = np.zeros((c, l, 2))
         self.last_speed = np.zeros((c, l))
         # the body's slowest and fastest since each foot's last touch-down
         self.slowest = np.zeros((c, l))
@@ -373,6 +394,7 @@ class StrideMeter:
         cs, ls = np.nonzero(landed)
         foot = state.feet[cs, ls][:, [0, 2]]
         pelvis = state.pelvis[cs][:, [0, 2]]
+        rest = rest_points(self.model, pelvis, state.heading[cs], state.feet_spacing[cs], ls)
         speed = state.speed[cs]
         goal = self.goal[cs]
         seen = self.last_frame[cs, ls] >= 0
@@ -380,18 +402,23 @@ class StrideMeter:
             a, b = cs[seen], ls[seen]
             duration = (k - self.last_frame[a, b]) * self.model.dt
             stride = np.hypot(*(foot[seen] - self.last_foot[a, b]).T)
-            v = np.hypot(*(pelvis[seen] - self.last_pelvis[a, b]).T) / duration
+            travel = np.hypot(*(pelvis[seen] - self.last_pelvis[a, b]).T)
+            v = travel / duration
+            # The foot's own share of the body's travel: its rest point's (1 on a straight stride).
+            share = np.hypot(*(rest[seen] - self.last_rest[a, b]).T) / np.maximum(travel, 1e-300)
             steady = ((self.last_speed[a, b] >= 0.5 * goal[seen]) & (speed[seen] >= 0.5 * goal[seen])
                       & (self.last_speed[a, b] <= 1.5 * goal[seen]) & (speed[seen] <= 1.5 * goal[seen]) & (v > 0)
-                      & (self.slowest[a, b] >= (1.0 - STEADY_BAND) * v) & (self.fastest[a, b] <= (1.0 + STEADY_BAND) * v))
+                      & (self.slowest[a, b] >= (1.0 - STEADY_BAND) * v) & (self.fastest[a, b] <= (1.0 + STEADY_BAND) * v)
+                      & (share > 0))
             if steady.any():
                 f = stride_frequency(self.model.timing, v[steady], self.model.leg_height)
-                self.errors.append(np.abs(stride[steady] * f / v[steady] - 1.0))
+                self.errors.append(np.abs(stride[steady] * f / (v[steady] * share[steady]) - 1.0))
                 if state.lod_level is not None:
                     self.levels.append(state.lod_level[a][steady])
         self.last_frame[cs, ls] = k
         self.last_foot[cs, ls] = foot
         self.last_pelvis[cs, ls] = pelvis
+        self.last_rest[cs, ls] = rest
         self.last_speed[cs, ls] = speed
         self.slowest[cs, ls] = speed
         self.fastest[cs, ls] = speed

@@ -172,9 +172,11 @@ def _stride_walk(speeds, strides):
     from footfall.planner._simulation import StrideMeter
     from footfall.planner._timing import GaitTiming
 
-    model = SimpleNamespace(dt=0.1, timing=GaitTiming(), leg_height=0.12, speed_cap=np.inf)
+    model = SimpleNamespace(dt=0.1, timing=GaitTiming(), leg_height=0.12, speed_cap=np.inf,
+                            rest_body=np.zeros((1, 2)))
     state = SimpleNamespace(desired_speed=np.array([0.3]), feet=np.zeros((1, 1, 3)), pelvis=np.zeros((1, 3)),
-                            speed=np.zeros(1), in_stance=np.ones((1, 1), np.bool_), lod_level=None)
+                            speed=np.zeros(1), in_stance=np.ones((1, 1), np.bool_), lod_level=None,
+                            heading=np.zeros(1), feet_spacing=np.ones(1))
     meter = StrideMeter(model, state)
     landings = {10 * (i + 1): float(x) for i, x in enumerate(np.cumsum(strides))}
     meter.update(0, SimpleNamespace(**{**vars(state), "speed": np.array([speeds[0]])}), np.ones((1, 1), np.bool_))
@@ -199,3 +201,53 @@ def test_a_stride_through_a_dodge_is_not_measured_against_the_law():
     dodge = steady[:13] + [0.05] * 4 + steady[17:]
     median, p90, n = _stride_walk(dodge, [1.1 * law, law, 0.8 * law])
     assert n == 2 and median == pytest.approx(0.15)
+
+
+def _circling(turn_rate, rest, frames=41):
+    """Per-stride errors of the feet of one body walking at 0.3 m/s and turning at ``turn_rate``
+    (rad/s), each foot landing on its rest point every 10 frames, dt chosen so that 10 frames are one
+    cycle of the law's tempo: every stride as long as the law asks of that foot."""
+    from types import SimpleNamespace
+
+    from footfall.planner._simulation import StrideMeter, rest_points
+    from footfall.planner._timing import GaitTiming, stride_frequency
+
+    v, legs = 0.3, len(rest)
+    model = SimpleNamespace(dt=0.1 / stride_frequency(GaitTiming(), v, 0.12), timing=GaitTiming(), leg_height=0.12,
+                            speed_cap=np.inf, rest_body=np.asarray(rest, dtype=np.float64))
+    state = SimpleNamespace(desired_speed=np.array([v]), feet=np.zeros((1, legs, 3)), pelvis=np.zeros((1, 3)),
+                            speed=np.array([v]), in_stance=np.ones((1, legs), np.bool_), lod_level=None,
+                            heading=np.zeros(1), feet_spacing=np.ones(1))
+    meter = StrideMeter(model, state)
+    for k in range(frames):
+        t = k * model.dt  # on the arc (radius v / turn_rate) exactly, or the straight line
+        state.heading = np.array([turn_rate * t])
+        if turn_rate:
+            radius = v / turn_rate
+            state.pelvis = np.array([[radius * np.sin(turn_rate * t), 0.0, radius * (1.0 - np.cos(turn_rate * t))]])
+        else:
+            state.pelvis = np.array([[v * t, 0.0, 0.0]])
+        landed = np.full((1, legs), k % 10 == 0)
+        if landed.any():
+            on_rest = rest_points(model, np.repeat(state.pelvis[:, [0, 2]], legs, axis=0), np.repeat(state.heading, legs),
+                                  np.ones(legs), np.arange(legs))
+            state.feet[0, :, 0], state.feet[0, :, 2] = on_rest[:, 0], on_rest[:, 1]
+        meter.update(k, state, landed)
+    return np.concatenate(meter.errors)
+
+
+def test_in_a_turn_each_foot_is_measured_against_its_own_share_of_the_travel():
+    from footfall.planner._timing import GaitTiming, stride_frequency
+
+    rest = [(0.2, 0.25), (0.2, -0.25)]  # a left and a right foot
+    assert np.abs(_circling(0.0, rest)).max() < 1e-12  # straight: every stride the law's
+    # Turning left at 0.6 rad/s (a 0.5 m radius): the left foot's rest point walks a circle of
+    # hypot(0.2, 0.25) = 0.32 m, the right one's of hypot(0.2, 0.75) = 0.78 m, 0.64 and 1.55 times the
+    # body's travel; each is measured against that share. Left: the body's own error, which comes from
+    # measuring its speed along the chord of its arc: |T f(v) - 1|, v = 2 R sin(w T / 2) / T.
+    errors = _circling(0.6, rest)
+    period = 1.0 / stride_frequency(GaitTiming(), 0.3, 0.12)
+    v = 2 * 0.5 * np.sin(0.6 * period / 2) / period
+    chord = abs(period * stride_frequency(GaitTiming(), v, 0.12) - 1.0)
+    np.testing.assert_allclose(errors, np.full(8, chord), rtol=1e-9)
+    assert 0 < chord < 0.002

@@ -78,7 +78,7 @@ def _recompute(recording, creature, model, start, goal):
                "body_overlaps": 0, "residuals": [], "errors": []} for k in range(n)}
     pop, switches = 0.0, 0
     anchor = rendered[0].copy()
-    last = {}  # (character, leg) -> (frame, foot xz, pelvis xz, speed) of its last landing
+    last = {}  # (character, leg) -> (frame, foot xz, pelvis xz, rest point xz, speed) of its last landing
     slowest, fastest = {}, {}  # (character, leg) -> the body's slowest / fastest speed since that landing
     obstacles = model.raster.obstacles
     body = creature.body_box
@@ -122,17 +122,22 @@ def _recompute(recording, creature, model, start, goal):
         for ch, leg in zip(*np.nonzero(landed)):
             foot = planned[k, ch, leg, [0, 2]]
             pelvis = recording.pelvis[was, ch, [0, 2]]
+            # the leg's rest point (feet spacing 1: the run changes none), turned with the heading
+            heading = float(recording.orientation[was, ch, 0])
+            ahead, side = model.rest_body[leg]
+            rest = pelvis + [ahead * np.cos(heading) - side * np.sin(heading), ahead * np.sin(heading) + side * np.cos(heading)]
             speed = recording.speed[was, ch]
             if (ch, leg) in last:
-                k0, foot0, pelvis0, speed0 = last[ch, leg]
+                k0, foot0, pelvis0, rest0, speed0 = last[ch, leg]
                 v = np.linalg.norm(pelvis - pelvis0) / ((k - k0) * model.dt)
+                share = np.linalg.norm(rest - rest0) / np.linalg.norm(pelvis - pelvis0) if v > 0 else 0.0
                 g = goal[ch]
-                if (0.5 * g <= speed0 <= 1.5 * g and 0.5 * g <= speed <= 1.5 * g and v > 0
+                if (0.5 * g <= speed0 <= 1.5 * g and 0.5 * g <= speed <= 1.5 * g and v > 0 and share > 0
                         and (1.0 - STEADY_BAND) * v <= slowest[ch, leg] and fastest[ch, leg] <= (1.0 + STEADY_BAND) * v):
                     stride = np.linalg.norm(foot - foot0)
                     f_v = float(stride_frequency(model.timing, np.array([v]), model.leg_height)[0])
-                    out[int(level[k, ch])]["errors"].append(abs(stride * f_v / v - 1.0))
-            last[ch, leg] = (k, foot, pelvis, speed)
+                    out[int(level[k, ch])]["errors"].append(abs(stride * f_v / (v * share) - 1.0))
+            last[ch, leg] = (k, foot, pelvis, rest, speed)
             slowest[ch, leg] = fastest[ch, leg] = speed
     return out, pop, switches
 
@@ -152,6 +157,7 @@ def test_the_reports_lod_quality_columns_are_what_the_recording_shows(tmp_path, 
     summary = simulate(model, state, FRAMES, recorder)
     recorder.save(tmp_path / "run.npz", model, summary, {"scenario": str(path), "seed": seed, "lod": "zoomed"})
     recording = load_recording(tmp_path / "run.npz")
+    assert (state.feet_spacing == 1.0).all()  # as _recompute takes it
     mine, pop, switches = _recompute(recording, creature, model, start, goal)
     where = f"seed {seed}"
 
