@@ -219,10 +219,11 @@ def test_a_tune_that_accepts_no_candidate_keeps_the_defaults(tmp_path, monkeypat
 
 
 @pytest.mark.slow  # a tiny tune (about 10 s)
-def test_a_tuned_preset_that_walks_worse_on_the_held_out_runs_is_not_shipped(tmp_path, monkeypatch):
+@pytest.mark.parametrize("worse", [{"stride_rel_error": 0.5}, {"exact_loss": 5.0}], ids=["stride", "loss"])
+def test_a_tuned_preset_that_walks_worse_on_the_held_out_runs_is_not_shipped(tmp_path, monkeypatch, worse):
     """Every step accepted on the training runs, but the held-out runs (a stand-in for the exact planner
-    there) find the tuned parameters' stride error higher than the defaults': the defaults ship, with the
-    refused round named in the summary."""
+    there) find the tuned parameters' stride error, or their whole loss, higher than the defaults': the
+    defaults ship, with the refused round named in the summary."""
     import footfall.tuning._tune as tune_module
     from footfall.planner import GaitTiming, ScoringWeights
 
@@ -233,7 +234,7 @@ def test_a_tuned_preset_that_walks_worse_on_the_held_out_runs_is_not_shipped(tmp
     def exact_metrics(setup, weights=None, timing=None, **kwargs):
         m = real(setup, weights, timing, **kwargs)
         if setup == held_out and weights != ScoringWeights():
-            m = dataclasses.replace(m, stride_rel_error=m.stride_rel_error + 0.5)
+            m = dataclasses.replace(m, **{k: getattr(m, k) + v for k, v in worse.items()})
         return m
 
     monkeypatch.setattr(tune_module, "_accept", lambda *args, **kwargs: (True, "improved"))
@@ -241,6 +242,7 @@ def test_a_tuned_preset_that_walks_worse_on_the_held_out_runs_is_not_shipped(tmp
     result = tune_module.tune(config, tmp_path / "refused.json", workers=1)
     preset = load_preset(tmp_path / "refused.json", "spider")
     assert result.summary["best_round"] == -1 and "round 0 refused on the held-out runs" in result.summary["heldout_refused"]
+    assert ("loss" if "exact_loss" in worse else "stride error") in result.summary["heldout_refused"]
     assert preset.weights == ScoringWeights() and preset.timing == GaitTiming()
     losses = preset.provenance["losses"]
     assert losses["heldout_tuned"] == losses["heldout_default"]
