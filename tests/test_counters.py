@@ -164,28 +164,37 @@ def test_a_foot_under_a_box_faster_than_the_creature_is_an_unavoidable_contact()
     assert (slow.collisions, slow.unavoidable_contacts) == (0, 1)
 
 
+def _walker(rest, dt):
+    """A stand-in model and state of one character with legs at ``rest`` (forward, lateral; m), asked
+    for 0.3 m/s, standing at the origin facing +x: what :class:`StrideMeter` reads."""
+    from types import SimpleNamespace
+
+    from footfall.planner._timing import GaitTiming
+
+    legs = len(rest)
+    model = SimpleNamespace(dt=dt, timing=GaitTiming(), leg_height=0.12, speed_cap=np.inf,
+                            rest_body=np.asarray(rest, dtype=np.float64))
+    state = SimpleNamespace(desired_speed=np.array([0.3]), feet=np.zeros((1, legs, 3)), pelvis=np.zeros((1, 3)),
+                            speed=np.zeros(1), in_stance=np.ones((1, legs), np.bool_), lod_level=None,
+                            heading=np.zeros(1), feet_spacing=np.ones(1))
+    return model, state
+
+
 def _stride_walk(speeds, strides):
     """One foot of one character landing every 10 frames (dt 0.1 s) at the given strides (m), the body
     at ``speeds[k]`` in frame k: the per-stride errors the meter measures."""
-    from types import SimpleNamespace
-
     from footfall.planner._simulation import StrideMeter
-    from footfall.planner._timing import GaitTiming
 
-    model = SimpleNamespace(dt=0.1, timing=GaitTiming(), leg_height=0.12, speed_cap=np.inf,
-                            rest_body=np.zeros((1, 2)))
-    state = SimpleNamespace(desired_speed=np.array([0.3]), feet=np.zeros((1, 1, 3)), pelvis=np.zeros((1, 3)),
-                            speed=np.zeros(1), in_stance=np.ones((1, 1), np.bool_), lod_level=None,
-                            heading=np.zeros(1), feet_spacing=np.ones(1))
+    model, state = _walker([(0.0, 0.0)], 0.1)
     meter = StrideMeter(model, state)
     landings = {10 * (i + 1): float(x) for i, x in enumerate(np.cumsum(strides))}
-    meter.update(0, SimpleNamespace(**{**vars(state), "speed": np.array([speeds[0]])}), np.ones((1, 1), np.bool_))
-    for k in range(1, len(speeds)):
+    for k in range(len(speeds)):
         state.speed = np.array([speeds[k]])
-        state.pelvis = state.pelvis + [[speeds[k] * model.dt, 0.0, 0.0]]
+        if k:
+            state.pelvis = state.pelvis + [[speeds[k] * model.dt, 0.0, 0.0]]
         if k in landings:
             state.feet = np.array([[[landings[k], 0.0, 0.0]]])
-        meter.update(k, state, np.full((1, 1), k in landings))
+        meter.update(k, state, np.full((1, 1), k == 0 or k in landings))
     return meter.summary()
 
 
@@ -207,17 +216,12 @@ def _circling(turn_rate, rest, frames=41):
     """Per-stride errors of the feet of one body walking at 0.3 m/s and turning at ``turn_rate``
     (rad/s), each foot landing on its rest point every 10 frames, dt chosen so that 10 frames are one
     cycle of the law's tempo: every stride as long as the law asks of that foot."""
-    from types import SimpleNamespace
-
     from footfall.planner._simulation import StrideMeter, rest_points
     from footfall.planner._timing import GaitTiming, stride_frequency
 
     v, legs = 0.3, len(rest)
-    model = SimpleNamespace(dt=0.1 / stride_frequency(GaitTiming(), v, 0.12), timing=GaitTiming(), leg_height=0.12,
-                            speed_cap=np.inf, rest_body=np.asarray(rest, dtype=np.float64))
-    state = SimpleNamespace(desired_speed=np.array([v]), feet=np.zeros((1, legs, 3)), pelvis=np.zeros((1, 3)),
-                            speed=np.array([v]), in_stance=np.ones((1, legs), np.bool_), lod_level=None,
-                            heading=np.zeros(1), feet_spacing=np.ones(1))
+    model, state = _walker(rest, 0.1 / stride_frequency(GaitTiming(), v, 0.12))
+    state.speed = np.array([v])
     meter = StrideMeter(model, state)
     for k in range(frames):
         t = k * model.dt  # on the arc (radius v / turn_rate) exactly, or the straight line
