@@ -19,7 +19,10 @@ feet for characters whose IK is off, which is how they are drawn):
   creature's top speed (``CrowdModel.top_speed``): no escape exists, so such a contact is
   counted apart from ``collisions``;
 * ``stuck_seconds``: character-seconds in which a character that has not reached its goal
-  moved less than 10 % of its asked speed over the last 2 s (:data:`STUCK_WINDOW_S`).
+  moved less than 10 % of its asked speed over the last 2 s (:data:`STUCK_WINDOW_S`);
+* ``max_pelvis_jump_m``: the largest change of a character's pelvis height from one frame to the
+  next (a body on its support hulls moves in steps where the hulls do: a robot5 fell 13 cm in a
+  frame beside a crate; :mod:`planner._kernels_body`). Reported, not a promise of ``evaluate``.
 
 Each counter is tested on hand-made states where it must read a known non-zero value
 (``tests/test_counters.py``).
@@ -96,6 +99,8 @@ class FrameCounters:
         self._stance = state.in_stance.copy()
         self._anchor = self._rendered_feet(state).copy()  # where each stance foot is (rendered)
         self._planned = state.feet.copy()
+        self.max_pelvis_jump_m = 0.0
+        self._pelvis_y = None  # the state a run starts from is never drawn: jumps from the first frame
 
     @staticmethod
     def _rendered_feet(state) -> np.ndarray:
@@ -135,6 +140,10 @@ class FrameCounters:
         self._anchor[landed] = feet[landed]
         self._planned[landed] = state.feet[landed]
         self._stance[:] = state.in_stance
+        if self._pelvis_y is not None:
+            self.max_pelvis_jump_m = max(self.max_pelvis_jump_m,
+                                         float(np.abs(state.pelvis[:, 1] - self._pelvis_y).max(initial=0.0)))
+        self._pelvis_y = state.pelvis[:, 1].copy()
         if state.ik_on.any():
             self.residuals.append(state.residual[state.ik_on].ravel().copy())
         self._crowd(state, feet)

@@ -400,6 +400,7 @@ class CrowdState:
     tucked: np.ndarray  # (C, L) bool: a threatened foot with no footprint, held up near its hip (tuck_swings)
     escaping: np.ndarray  # (C,) bool: the last steer stage turned the character out of a moving box's lane
     goal_speed: np.ndarray  # (C,) m/s: the speed the last steer stage headed for (0 at the goal; braking before it)
+    speed_wanted: np.ndarray  # (C,) m/s: the speed the last steer stage asked after turns, avoidance and limits
     blocks_escape: np.ndarray  # (C, L) bool: a stance foot that stops an escaping character's turn
     crossed: np.ndarray  # (C, L, L) bool: pairs of stance legs drawn crossed at the end of the last frame
     counters: dict = field(default_factory=dict)
@@ -599,6 +600,7 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
     state.speed_limit[free] += ctl.limit_recovery * state.desired_speed[free] * dt
     v_des = np.minimum(v_des, np.where(avoided, np.maximum(state.speed_limit, v_des), state.speed_limit))
     v_des = np.minimum(v_des, braking)
+    state.speed_wanted = v_des
     state.speed = state.speed + np.clip(v_des - state.speed, -ctl.acceleration * dt, ctl.acceleration * dt)
     # Legs that reach: no faster than keeps every stance foot inside its leg's stance window until
     # the needle lifts it (planner._workspace). The cap falls gradually as a foot nears the rear
@@ -1551,7 +1553,7 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     v = state.speed[cs]
     # Where the body will be: it keeps accelerating toward its goal speed (a foot planned at the
     # start of a speed-up would otherwise land for the slower speed and trail out of reach).
-    goal = sustained_speed(state)[cs]
+    goal = state.speed_wanted[cs]
     travel_swing = travel(v, goal, model.controller.acceleration, t_swing)
     pred = state.pelvis[cs][:, [0, 2]] + fwd * travel_swing[:, None]
     spacing = state.feet_spacing[cs]
@@ -2282,7 +2284,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         ik_on=np.zeros(n, np.bool_), fk_feet=feet.copy(), pelvis_base=np.zeros(n), pelvis_rise=np.zeros(n), body_held=np.zeros(n, np.bool_), speed_limit=np.full(n, np.inf), last_move=np.zeros((n, 2)), cannot_follow=np.zeros((n, L), np.bool_), unfollowed=np.zeros((n, L), np.bool_), pose_before=np.zeros((n, 7)),
         gait_index=gait_index, stride_frequency=np.zeros(n), turn_wanted=np.zeros(n),
         threatened=np.zeros((n, L), np.bool_), tucked=np.zeros((n, L), np.bool_),
-        escaping=np.zeros(n, np.bool_), goal_speed=np.full(n, speed), blocks_escape=np.zeros((n, L), np.bool_), crossed=np.zeros((n, L, L), np.bool_),
+        escaping=np.zeros(n, np.bool_), goal_speed=np.full(n, speed), speed_wanted=np.zeros(n), blocks_escape=np.zeros((n, L), np.bool_), crossed=np.zeros((n, L, L), np.bool_),
         counters={k: 0 for k in ("steps", "plans", "holds", "replans", "forbidden_footprints", "cells_expanded",
                                  "couples_evaluated", "pose_takebacks", "crossing_takebacks", "map_cells_built", "ik_ccd_legs", "ik_two_bone_legs")},
         lod_level=np.full(n, LEVEL_FULL, np.int8), near_moving_box=np.zeros(n, np.bool_),

@@ -63,6 +63,8 @@ class SimulationSummary:
     stuck_seconds : float
         Character-seconds in which a character short of its goal moved less than 10 % of its
         asked speed over the last 2 s.
+    max_pelvis_jump_m : float
+        m: the largest change of a pelvis's height from one frame to the next.
     ms_per_frame_median, ms_per_frame_mean : float
         Frame times, ms (the mean includes the first frame).
     ms_per_frame_warmup, ms_per_frame_steady : float or None
@@ -132,6 +134,7 @@ class SimulationSummary:
     shared_foot_spots: int = 0
     stuck_seconds: float = 0.0
     unavoidable_contacts: int = 0
+    max_pelvis_jump_m: float = 0.0
     ms_per_frame_warmup: float | None = None
     """The first frame's ms: a fresh process loads (or, on a cold cache, compiles) the numba kernels
     there, so it can be 100x a steady frame; ``ms_per_frame_mean`` includes it."""
@@ -586,6 +589,7 @@ def simulate(model: CrowdModel, state: CrowdState, frames: int, recorder: Record
         speed_reached=reached, duty_factor_mean=stance_feet / walking_feet if walking_feet else None,
         body_overlaps=counters.body_overlaps, shared_foot_spots=counters.shared_foot_spots,
         stuck_seconds=counters.stuck_seconds, unavoidable_contacts=counters.unavoidable_contacts,
+        max_pelvis_jump_m=counters.max_pelvis_jump_m,
         ms_per_frame_warmup=float(frame_ms[0]) if frames else None,
         ms_per_frame_steady=float(np.mean(frame_ms[1:])) if frames > 1 else None,
         lod_levels=levels.summary(*strides.by_level()) if levels is not None else None,

@@ -93,6 +93,22 @@ def test_a_stance_foot_creeping_slowly_is_caught_against_its_touch_down_point():
     assert fresh.max_stance_slip_m == 0.0
 
 
+def test_a_pelvis_dropping_in_one_frame_is_its_largest_jump():
+    model, state = _standing("flat")
+    counters = FrameCounters(model, state)
+    state.pelvis[1, 1] -= 0.5  # before the first frame drawn: no jump
+    counters.update(state)
+    for _ in range(20):  # 1 mm a frame: 20 mm lower, no frame jumps more than 1 mm
+        state.pelvis[0, 1] -= 1e-3
+        counters.update(state)
+    assert counters.max_pelvis_jump_m == pytest.approx(1e-3, rel=1e-9)
+    state.pelvis[1, 1] += 0.03
+    counters.update(state)
+    state.pelvis[1, 1] -= 0.01
+    counters.update(state)
+    assert counters.max_pelvis_jump_m == pytest.approx(0.03, rel=1e-9)
+
+
 def test_a_target_out_of_reach_shows_in_the_ik_residual():
     model, state = _standing("flat")
     counters = FrameCounters(model, state)

@@ -695,7 +695,7 @@ def test_a_tucked_foot_is_no_support_for_the_pelvis():
     # A spider standing on flat ground: its pelvis height, pitch and roll from the hulls of its feet.
     # One foot tucked up near its hip (a tuck point half the hip's height above the ground) lands
     # nowhere: on flat ground the other seven give the pose of the eight, to the last bit. Counted as a foot standing at
-    # its tuck point, it moved and tilted the body (checked with the tuck point as support).
+    # its tuck point, it moves the body (checked with the tuck point as support).
     from footfall.planner._crowd import stage_pelvis, tuck_swings
 
     model, state, (_, _, hips, _) = _standing_on_flat("spider")
@@ -710,6 +710,9 @@ def test_a_tucked_foot_is_no_support_for_the_pelvis():
     tuck_swings(model, state, np.array([0]), np.array([0]), hips, np.array([0.1]))
     assert state.swing_target[0, 0, 1] > state.feet[0, 1, 1] + 0.02, "premise: the tuck point is up in the air"
     assert pose() == standing
-    state.tucked[0, 0] = False  # as a foot landing at its tuck point: the body drops 2.4 cm and tilts
+    # As a foot landing at its tuck point the body rises 4.3 cm onto the hull it lifts (it tilted
+    # 0.05 rad toward it and dropped 2.4 cm before the tilt was kept within the legs' reach,
+    # planner._kernels_body.carried_tilt).
+    state.tucked[0, 0] = False
     y, pitch, roll = pose()
-    assert y < standing[0] - 0.01 and abs(pitch - standing[1]) > 0.05 and abs(roll - standing[2]) > 0.05
+    assert y > standing[0] + 0.03

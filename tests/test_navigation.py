@@ -216,9 +216,11 @@ def _behind_a_crate(tmp_path, navigate: bool):
 
 def test_a_quadruped_whose_goal_lies_behind_a_forbidden_crate_walks_round_it(tmp_path):
     """The stuck case of the crowds issue's bar set, alone: a quadruped walking at a 2 m wide forbidden
-    crate dead ahead, its goal straight behind it. Aimed round the crate it is well past it after 15 s;
-    steered straight at the goal (``ControllerConfig.navigate`` off; on by default), ORCA slid it along the
-    crate's face and it is barely past (x 0.41; in crowds such characters stalled)."""
+    crate dead ahead, its goal straight behind it. Aimed round the crate it is well past it after 15 s
+    (x 1.08); steered straight at the goal (``ControllerConfig.navigate`` off; on by default), ORCA held it
+    at the crate's face for 2 s and slid it along, and it is 0.3 m behind (x 0.78; 0.41 while its feet
+    were planned for the speed it headed for rather than the one the steering asked; in crowds such
+    characters stalled)."""
     from footfall.planner import simulate
 
     runs = {}
@@ -228,7 +230,7 @@ def test_a_quadruped_whose_goal_lies_behind_a_forbidden_crate_walks_round_it(tmp
     (summary, x), (straight, x_straight) = runs[True], runs[False]
     assert summary.stuck_seconds == 0.0 and summary.collisions == 0
     assert x > 1.0, f"past the crate (its far face at x = 0.3): x = {x:.2f}"
-    assert x_straight < 0.5, "the case must be slow without the way round"
+    assert x_straight < x - 0.25, "the case must be slower without the way round"
 
 
 def test_the_crowds_way_rounds_static_boxes_and_the_region_a_looping_box_sweeps():

@@ -24,12 +24,12 @@ STANDING, THICKNESS = 0.3, 0.01
 FEET = np.array([[[0.5, 0.2, 0.5], [-0.5, 0.2, 0.5], [0.5, 0.0, -0.5], [-0.5, 0.0, -0.5]]])
 
 
-def _pose(smoothing, last, most=10.0):
+def _pose(smoothing, last, most=10.0, feet=FEET):
     """(y, pitch, roll, base) of the scene's body, from the last frame's (base, pitch, roll)."""
     top = np.zeros((5, 5))
     heights = np.tile([0.0, most], (4, 1))
     out = [np.empty(1) for _ in range(4)]
-    pelvis_from_hulls(top, -2.5, -2.5, 1.0, np.array([[0.0, 0.4, 0.0]]), np.zeros(1), FEET,
+    pelvis_from_hulls(top, -2.5, -2.5, 1.0, np.array([[0.0, 0.4, 0.0]]), np.zeros(1), feet,
                       np.ones((1, 4), np.bool_), np.ones((1, 4), np.bool_), 0.2, 0.2, STANDING, heights, THICKNESS,
                       np.zeros(1), smoothing,
                       np.array([last[0]]), np.array([last[1]]), np.array([last[2]]), *out)
@@ -69,3 +69,49 @@ def test_the_lag_is_checked():
         ControllerConfig(pelvis_lag=-0.1)
     with pytest.raises(ValueError, match="pelvis_lag"):
         ControllerConfig(pelvis_lag=math.nan)
+
+
+def test_the_body_tilts_only_as_far_as_its_legs_reach():
+    """A foot standing high between the others tilts the hulls toward it (a robot5 with a foot on a
+    crate): rear feet at x = -0.5 (z = +-0.5) and a front-right foot at (0.5, -0.5) on the ground, a
+    left foot at (0.25, 0.5) on a 0.2 m step. The sagittal hull runs (-0.5, 0) - (0.25, 0.2) - (0.5,
+    0), slope 0.2667 under the centre; the lateral one (-0.5, 0) - (0.5, 0.2), 0.1 m under it, slope
+    0.2: the pelvis stands at 0.1 + 0.3 = 0.4 m. Legs reach 0.42 m above their feet along the body's
+    up axis: upright, every foot reaches; fully tilted (pitch atan 0.2667, roll atan 0.2) the
+    front-right foot lies 0.434 m below the pelvis, out of reach. The body tilts the largest
+    fraction of the hulls' slopes at which that foot reaches (found here by a root-finder, to the
+    kernel's bisection resolution of 1/512), the pelvis at standing height."""
+    from scipy.optimize import brentq
+
+    feet = np.array([[[0.25, 0.2, 0.5], [-0.5, 0.0, 0.5], [0.5, 0.0, -0.5], [-0.5, 0.0, -0.5]]])
+
+    def below_pelvis(foot, tilt):  # how far under the pelvis's up axis a foot's reach ends
+        pitch, roll = math.atan(tilt * 0.2 / 0.75), math.atan(tilt * 0.2)
+        x, y, z = foot
+        ground = y - math.sin(pitch) * x - math.cos(pitch) * math.sin(roll) * z
+        return ground + math.cos(pitch) * math.cos(roll) * 0.42 - 0.4
+
+    assert below_pelvis(feet[0, 2], 1.0) < -0.02 and below_pelvis(feet[0, 2], 0.0) > 0.0
+    tilt = brentq(lambda a: below_pelvis(feet[0, 2], a), 0.0, 1.0)
+    assert all(below_pelvis(foot, tilt) >= 0.0 for foot in feet[0])
+    y, pitch, roll, base = _pose(1.0, (0.0, 0.0, 0.0), most=0.42, feet=feet)
+    assert math.tan(roll) / 0.2 == pytest.approx(math.tan(pitch) / (0.2 / 0.75), abs=TOL)  # one tilt for both
+    assert math.tan(roll) / 0.2 == pytest.approx(tilt, abs=1 / 512)
+    assert math.tan(roll) / 0.2 <= tilt + 1e-12  # the largest tilt that reaches, not the next one
+    assert (y, base) == pytest.approx((0.4, 0.4), abs=TOL)
+
+
+def test_carried_tilt_by_hand():
+    """One support point 1 m ahead on the ground, its leg reaching 1 m; hull slope 1 (45 degrees).
+    A pelvis at cos p - sin p is in reach for pitches up to p: at 0.4472 (tan p = 0.5) the tilt is
+    a half; at 1 the body cannot tilt at all; below the reach at full tilt it tilts fully."""
+    from footfall.planner._kernels_body import carried_tilt
+
+    s, y, t = np.array([0.0, 0.0, 0.0, 1.0]), np.zeros(4), np.zeros(4)
+    stance, least, most = np.zeros(4, np.bool_), np.zeros(4), np.ones(4)
+    half = math.cos(math.atan(0.5)) - math.sin(math.atan(0.5))
+    assert carried_tilt(1.0, 0.0, s, y, t, 4, stance, least, most, half) == pytest.approx(0.5, abs=1 / 512)
+    assert carried_tilt(1.0, 0.0, s, y, t, 4, stance, least, most, 1.0) == 0.0
+    assert carried_tilt(1.0, 0.0, s, y, t, 4, stance, least, most, 0.0) == 1.0
+    # No tilt reaches (a pelvis 2 m up): the one that leaves the least violation, upright.
+    assert carried_tilt(1.0, 0.0, s, y, t, 4, stance, least, most, 2.0) == 0.0

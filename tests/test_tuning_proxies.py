@@ -166,8 +166,28 @@ def test_soft_selection_tends_to_the_hard_choice_as_tau_goes_to_zero(situations,
         errors.append(max(float(np.abs(np.asarray(soft[k]) - np.asarray(hard[k])).max()) / scale[k]
                           for k in tuning.PROXY_METRICS))
     assert errors[0] > 1e-3  # at tau = 0.1 the selection is really soft
-    assert all(b <= a for a, b in zip(errors, errors[1:])), errors
     assert errors[-1] <= LIMIT_RTOL, errors
+    # On the way, a situation's error is its softmax's weight off the top couples times how far
+    # their metrics lie from the top's, at most: a bound that falls with tau (the largest error over
+    # the situations need not: a far-off couple fading later than a near one raised it 1.0 -> 1.7
+    # from tau 0.1 to 0.01 on one harvest).
+    mask = np.asarray(sit.couple_mask)
+    values = tuning._proxies._couple_metrics(jnp.asarray(scores.reshape(mask.shape)), timing, sit, jnp.inf)
+    off_top = ~tied.reshape(mask.shape) & mask
+    previous = np.inf
+    for tau, soft in zip(taus, softs):
+        p = np.asarray(tuning.soft_selection(jnp.asarray(scores.reshape(mask.shape)), sit.couple_mask, tau))
+        weight_off = (p * off_top).sum(axis=(1, 2))
+        assert (weight_off <= previous + 1e-15).all()
+        previous = weight_off
+        for k in tuning.PROXY_METRICS:
+            v, h = np.asarray(values[k]), np.asarray(hard[k])
+            spread = np.where(off_top, np.abs(v - h[:, None, None]), 0.0).max(axis=(1, 2))
+            err = np.abs(np.asarray(soft[k]) - h)
+            # uncapped clearances are infinite where nothing is near: no distance to bound there
+            finite = same & np.isfinite(err) & np.isfinite(spread)
+            size = max(float(np.abs(h[finite]).max(initial=0.0)), 1e-300)
+            assert (err[finite] <= weight_off[finite] * spread[finite] + LIMIT_RTOL * size).all(), (k, tau)
 
 
 def test_probabilities_are_a_distribution_over_the_valid_couples(situations, point):

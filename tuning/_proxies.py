@@ -695,12 +695,15 @@ def hard_metrics(weights, timing, situations: Situations, clearance_cap_m=jnp.in
 
 
 def _metrics_under(p, scores, timing, s, clearance_cap_m, touchdown_cap_m=None):
-    """The PROXY_METRICS under the selection p (F, K, S)."""
+    """The PROXY_METRICS under the selection p (F, K, S): the expectations of :func:`_couple_metrics`."""
+    # invalid couples have p = 0 and are zeroed (no inf * 0)
+    return {key: jnp.sum(p * jnp.where(s.couple_mask, values, 0.0), axis=(1, 2))
+            for key, values in _couple_metrics(scores, timing, s, clearance_cap_m, touchdown_cap_m).items()}
+
+
+def _couple_metrics(scores, timing, s, clearance_cap_m, touchdown_cap_m=None):
+    """The PROXY_METRICS of every couple, (F, K, S) each (invalid couples: any value)."""
     pref = preferred_footprint(timing, s)
-
-    def expect(values):  # values (F, K, S); invalid couples have p = 0 and are zeroed (no inf * 0)
-        return jnp.sum(p * jnp.where(s.couple_mask, values, 0.0), axis=(1, 2))
-
     x = footprints(s, pref)
     step = _norm(x[..., 0] - s.source[:, None, 0], x[..., 1] - s.source[:, None, 2])
     ahead = ((x[..., 0] - pref[:, None, 0]) * s.forward[:, None, 0]
@@ -725,19 +728,19 @@ def _metrics_under(p, scores, timing, s, clearance_cap_m, touchdown_cap_m=None):
         return jnp.broadcast_to(values[..., None], shape)
 
     return {
-        "step_length_m": expect(per_candidate(step)),
-        "forward_offset_m": expect(per_candidate(ahead)),
-        "offset_m": expect(per_candidate(offset)),
-        "touchdown_slope_rad": expect(per_candidate(s.cand_features[..., FEAT_SLOPE])),
-        "touchdown_roughness_m": expect(per_candidate(s.cand_features[..., FEAT_ROUGHNESS])),
-        "detour_ratio": expect(raw[..., RAW_LENGTH] / d_ref[..., None]),
-        "touchdown_clearance_m": expect(per_candidate(jnp.broadcast_to(prox_capped, step.shape))),
-        "length_m": expect(raw[..., RAW_LENGTH]),
-        "curvature_energy": expect(raw[..., RAW_CURVATURE]),
-        "clearance_m": expect(capped),
-        "climb_m": expect(raw[..., RAW_CLIMB]),
-        "jerk": expect(raw[..., RAW_JERK]),
-        "couple_score": expect(scores),
+        "step_length_m": per_candidate(step),
+        "forward_offset_m": per_candidate(ahead),
+        "offset_m": per_candidate(offset),
+        "touchdown_slope_rad": per_candidate(s.cand_features[..., FEAT_SLOPE]),
+        "touchdown_roughness_m": per_candidate(s.cand_features[..., FEAT_ROUGHNESS]),
+        "detour_ratio": raw[..., RAW_LENGTH] / d_ref[..., None],
+        "touchdown_clearance_m": per_candidate(jnp.broadcast_to(prox_capped, step.shape)),
+        "length_m": raw[..., RAW_LENGTH],
+        "curvature_energy": raw[..., RAW_CURVATURE],
+        "clearance_m": capped,
+        "climb_m": raw[..., RAW_CLIMB],
+        "jerk": raw[..., RAW_JERK],
+        "couple_score": scores,
     }
 
 
