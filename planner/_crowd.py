@@ -578,12 +578,13 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
     # A held body keeps its whole pose (a turn swings the hips away from the stance feet just as a
     # move does), and a character at its goal stops turning toward it.
     turn[state.body_held | (arrived & ~avoided)] = 0.0
-    # The feet are planned for walking along the heading: a body turning on the spot swings its
-    # hips across the stance feet (legs cross): below a quarter of its goal speed, a character
-    # turns more slowly, down to a quarter of the turn rate when standing.
-    rate = ctl.turn_rate * dt * np.clip(4.0 * state.speed / np.maximum(goal_speed, 1e-9), 0.25, 1.0)
-    # Out of a moving box's way: turning fast is the escape (the body walks only along its heading).
-    rate = np.where(in_lane, ctl.turn_rate * dt, rate)
+    # One turn rate, standing or walking. A body turning on the spot swings its hips across its stance
+    # feet, and it once turned at a quarter of the rate when standing; the stance feet's turn bounds
+    # and the uncrossing turn below now keep its legs apart, and the slow turn left a quadruped
+    # avoiding a neighbour, its way behind it, standing 2-7 s while it came round (crates-moving, every
+    # seed of the bar set). Without it: the bar set's stuck 45 -> 30 s, per-stride runs 19 -> 16,
+    # crossing frames 0 -> 0; the small crowded sets' stuck 981 -> 651 s, feet in boxes 36 -> 33.
+    rate = ctl.turn_rate * dt
     state.escaping = in_lane
     state.turn_wanted = np.clip(turn, -rate, rate)
     lo, hi = stance_turn_bounds(model, state)
@@ -657,8 +658,7 @@ in a symmetric standstill (two characters exactly head-on), a shared convention 
 
 
 MOBILE_FRACTION = 0.25
-"""x goal speed: a character slower than this cannot make way; its neighbours avoid it alone (below a
-quarter of its goal speed it also turns more slowly, ``stage_steer``)."""
+"""x goal speed: a character slower than this cannot make way; its neighbours avoid it alone."""
 
 LANE_HORIZON = 3.0
 """s: a moving box that will reach a character within this time makes it leave the box's lane."""
@@ -2357,9 +2357,12 @@ def _too_tall_forbidden(obstacles, highest: float):
 
 def _initial_feet(model: CrowdModel, positions, headings):
     """Rest feet at their rest positions (footprints are continuous points), resting on the highest
-    point of the world raster under the foot (its cell and the 8 around it). A rest foot within a
-    foot's room of another character's (neighbours spawned close, their legs interleaved) moves
-    straight away from it to just beyond that room (:func:`_spawned_feet_apart`)."""
+    point of the world raster under the foot (its cell and the 8 around it) that it may stand on: a
+    forbidden box's top is none (a spider spawned beside a 0.78 m forbidden crate stood a foot on its
+    top, held by a leg it could not reach for the whole run; the ground under the foot where every
+    cell around is forbidden). A rest foot within a foot's room of another character's (neighbours
+    spawned close, their legs interleaved) moves straight away from it to just beyond that room
+    (:func:`_spawned_feet_apart`)."""
     r = model.raster
     fx, fz = _rot_xz(headings[:, None], model.rest_body[None, :, 0], model.rest_body[None, :, 1])
     fx = fx + positions[:, None, 0]
@@ -2371,7 +2374,9 @@ def _initial_feet(model: CrowdModel, positions, headings):
     top = np.full(rows.shape, -np.inf)
     for dr in (-1, 0, 1):
         for dc in (-1, 0, 1):
-            top = np.maximum(top, r.static_top[rows + dr, cols + dc])
+            allowed = r.static_forbidden[rows + dr, cols + dc] == 0
+            top = np.maximum(top, np.where(allowed, r.static_top[rows + dr, cols + dc], -np.inf))
+    top = np.where(np.isfinite(top), top, r.ground[rows, cols])
     return np.stack([fx, top, fz], axis=-1)
 
 
