@@ -75,6 +75,14 @@ def upper_hull_at_zero(s, y, n):
 
 
 @nb.njit(cache=True)
+def _ground_along_up(y, s, t, sp, cpsr):
+    """The height term of a support point at ground offsets ``s`` (ahead), ``t`` (left) and height ``y``
+    under a body of pitch sine ``sp`` and cos(pitch) sin(roll) ``cpsr``: the pelvis stands within
+    this + cos(pitch) cos(roll) x [least, most] of its leg's height range (:func:`pelvis_from_hulls`)."""
+    return y - sp * s - cpsr * t
+
+
+@nb.njit(cache=True)
 def _reach_violation(tilt, slope, slope_l, s, y, t, m, in_stance_legs, heights_least, heights_most, target):
     """How far (m) a pelvis at ``target`` lies outside the height ranges of its support points
     (indices 3..m-1 of ``s``, ``y``, ``t``) with the hulls' slopes scaled by ``tilt``: the sum over the
@@ -86,7 +94,7 @@ def _reach_violation(tilt, slope, slope_l, s, y, t, m, in_stance_legs, heights_l
     cpsr = math.cos(pitch) * math.sin(roll)
     out = 0.0
     for k in range(3, m):
-        foot = y[k] - sp * s[k] - cpsr * t[k]
+        foot = _ground_along_up(y[k], s[k], t[k], sp, cpsr)
         out += max(0.0, target - (foot + cpcr * heights_most[k]))
         if in_stance_legs[k]:
             out += max(0.0, foot + cpcr * heights_least[k] - target)
@@ -179,6 +187,9 @@ def pelvis_from_hulls(top, origin_x, origin_z, cell, pelvis, heading, support, i
             y[m] = support[c, i, 1]
             t[m] = -dx * sn + dz * cs
             yl[m] = support[c, i, 1]
+            least[m] = heights[i, 0]
+            most[m] = heights[i, 1]
+            stance_point[m] = in_stance[c, i]
             m += 1
         h, slope = upper_hull_at_zero(s, y, m)
         hl, slope_l = upper_hull_at_zero(t, yl, m)
@@ -193,13 +204,6 @@ def pelvis_from_hulls(top, origin_x, origin_z, cell, pelvis, heading, support, i
         # out of its leg's reach below a pelvis at standing height, the pelvis fell 13 cm in one frame
         # to reach it, and rose 7 cm in the next a stance foot's folding asked for. The body tilts
         # only as far as every support point reaches a pelvis at standing height above the hull.
-        m_legs = 3
-        for i in range(n_legs):
-            if lands[c, i]:
-                least[m_legs] = heights[i, 0]
-                most[m_legs] = heights[i, 1]
-                stance_point[m_legs] = in_stance[c, i]
-                m_legs += 1
         tilt = carried_tilt(slope, slope_l, s, y, t, m, stance_point, least, most, h + standing_height)
         slope *= tilt
         slope_l *= tilt
@@ -217,16 +221,12 @@ def pelvis_from_hulls(top, origin_x, origin_z, cell, pelvis, heading, support, i
         low = -np.inf
         high = np.inf
         reach = np.inf
-        k = 3
-        for i in range(n_legs):
-            if not lands[c, i]:
-                continue
-            foot = y[k] - sp * s[k] - cpsr * t[k]
-            k += 1
-            reach = min(reach, foot + cpcr * heights[i, 1])
-            if in_stance[c, i]:
-                low = max(low, foot + cpcr * heights[i, 0])
-                high = min(high, foot + cpcr * heights[i, 1])
+        for k in range(3, m):
+            foot = _ground_along_up(y[k], s[k], t[k], sp, cpsr)
+            reach = min(reach, foot + cpcr * most[k])
+            if stance_point[k]:
+                low = max(low, foot + cpcr * least[k])
+                high = min(high, foot + cpcr * most[k])
         base = max(min(h + standing_height, reach), low)
         if smoothing < 1.0:
             # The lag is the body's; the stance feet's reach and the ground under the body are hard
