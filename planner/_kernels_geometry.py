@@ -39,8 +39,10 @@ def rect_overlaps_aabb(cx, cz, hx, hz, yaw, ax, az, ahx, ahz):
 
 
 @nb.njit(cache=True)
-def rasterise_boxes(top, forbidden, origin_x, origin_z, cell, centres, sizes, yaws, box_forbidden, selected):
-    """Voxelise boxes onto a grid: raise ``top`` to each box's top and flag forbidden cells.
+def rasterise_boxes(top, forbidden, origin_x, origin_z, cell, centres, sizes, yaws, box_forbidden, selected,
+                    mark=1):
+    """Voxelise boxes onto a grid: raise ``top`` to each box's top and flag forbidden cells
+    (``forbidden`` set to ``mark``: :data:`planner.layout.FORBIDDEN_MOVING` for moving boxes).
 
     A cell is covered when its square overlaps the box's footprint (conservative,
     rotated boxes included). Only boxes with ``selected[i]`` are drawn.
@@ -70,7 +72,7 @@ def rasterise_boxes(top, forbidden, origin_x, origin_z, cell, centres, sizes, ya
                     if box_top > top[r, c]:
                         top[r, c] = box_top
                     if box_forbidden[i]:
-                        forbidden[r, c] = 1
+                        forbidden[r, c] = mark
 
 
 @nb.njit(cache=True)

@@ -14,6 +14,7 @@ import numba as nb
 import numpy as np
 
 from footfall.planner._kernels_geometry import rasterise_boxes, rect_overlaps_aabb
+from footfall.planner.layout import FORBIDDEN_MOVING
 
 
 @nb.njit(cache=True)
@@ -50,7 +51,8 @@ def _window(ground, static_top, static_forbidden, g_origin_x, g_origin_z, cell, 
             selected[i] = True
             any_near = True
     if any_near:
-        rasterise_boxes(out_elev, out_forb, ox, oz, cell, box_centres, box_sizes, box_yaws, box_forbidden, selected)
+        rasterise_boxes(out_elev, out_forb, ox, oz, cell, box_centres, box_sizes, box_yaws, box_forbidden, selected,
+                        FORBIDDEN_MOVING)
     return ox, oz
 
 

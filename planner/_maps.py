@@ -19,6 +19,7 @@ import numpy as np
 
 from footfall.planner._grid import GridFrame
 from footfall.planner._kernels_geometry import rasterise_boxes
+from footfall.planner.layout import FORBIDDEN_MOVING
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:
@@ -44,7 +45,9 @@ class LocalMaps:
     ground : ndarray
         (R, C) float64, terrain height at the cell centres (m).
     forbidden : ndarray
-        (R, C) uint8, 1 where a forbidden box or the world's edge is.
+        (R, C) uint8, nonzero where a forbidden box or the world's edge is: ``FORBIDDEN_MOVING`` (2) where
+        a moving box is, 1 elsewhere (a foot beside a static box never swings through it; beside a
+        moving one it may, the way out of its path: ``planner._kernels_foot._open_escape``).
 
     Examples
     --------
@@ -229,5 +232,5 @@ class WorldRaster:
                     rasterise_boxes(top, forbidden, frame.origin_x, frame.origin_z, cell, centres,
                                     np.ascontiguousarray(obstacles.sizes, dtype=np.float64),
                                     np.ascontiguousarray(yaws, dtype=np.float64),
-                                    np.ascontiguousarray(obstacles.forbidden, dtype=np.bool_), near)
+                                    np.ascontiguousarray(obstacles.forbidden, dtype=np.bool_), near, FORBIDDEN_MOVING)
         return LocalMaps(frame, np.ascontiguousarray(top), np.ascontiguousarray(ground), forbidden)

@@ -8,7 +8,7 @@ entries through the same constants. Nothing else defines an index.
 * **Footprint features** (``FEATURES``, ``FEAT_*``): the raw numbers a footprint is scored from
   (:func:`planner._kernels_foot.footprint_features`; the harvest's ``cand_features`` columns).
 * **Trajectory metrics** (``RAW_METRICS``, ``RAW_*``): the raw numbers of a swing path.
-* **Search counters** (``COUNTERS``, ``CNT_*``).
+* **Search counters** (``COUNTERS``, ``CNT_*``); the **obstacles' map values** (``FORBIDDEN_*``).
 * **Scores** (``SCORES``, ``SCORE_*``), **search modes** (``SEARCH_MODES``, ``MODE_*``) and the
   crowd's **request kinds** (``REQUEST_KINDS``, ``KIND_*``).
 * **Scoring weights** (``WEIGHT_FIELDS``, ``W_*``; terms ``SCORE_TERMS``), the **gait timing**
@@ -74,6 +74,12 @@ RAW_METRICS: tuple[str, ...] = ("length_m", "curvature_energy", "clearance_m", "
 """Raw trajectory metrics of a swing path."""
 RAW_LENGTH, RAW_CURVATURE, RAW_CLEARANCE, RAW_CLIMB, RAW_JERK = range(len(RAW_METRICS))
 N_RAW = len(RAW_METRICS)
+
+FORBIDDEN_STATIC, FORBIDDEN_MOVING = 1, 2
+"""The values of a local obstacles' map (``LocalMaps.forbidden``; 0 where feet may go): a static
+forbidden box, another character's body or the world's edge; a moving forbidden box. A foot beside
+a moving box may swing out through its cells, beside a static one never
+(:func:`planner._kernels_foot._open_escape`)."""
 
 COUNTERS: tuple[str, ...] = ("couples_evaluated", "couples_2d", "cells_expanded", "wavefronts", "candidates", "slices")
 """The search's counters of one foot."""

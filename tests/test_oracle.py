@@ -356,8 +356,8 @@ class Oracle:
                 e = self.elev_dil[r, c]
                 rough = max(abs(self.elev[r + dr, c + dc] - e) for dr in (-1, 0, 1) for dc in (-1, 0, 1)
                             if (dr, dc) != (0, 0))
-                gx = (self.elev_dil[r, c + 1] - self.elev_dil[r, c - 1]) / (2 * cell)
-                gz = (self.elev_dil[r + 1, c] - self.elev_dil[r - 1, c]) / (2 * cell)
+                gx = _minmod(self.elev_dil[r, c + 1] - self.elev_dil[r, c], self.elev_dil[r, c] - self.elev_dil[r, c - 1]) / cell
+                gz = _minmod(self.elev_dil[r + 1, c] - self.elev_dil[r, c], self.elev_dil[r, c] - self.elev_dil[r - 1, c]) / cell
                 slope = math.atan(math.hypot(gx, gz))
                 dist = math.hypot(tx - px, tz - pz)
                 prox = self.proximity[r, c]
@@ -1013,6 +1013,11 @@ def test_a_leg_over_a_boxs_ring_does_not_hide_the_box():
 # Cells of 10 cm, origin (0, 0): cell (r, c) spans x in [0.1 c, 0.1 (c + 1)], z in [0.1 r, 0.1 (r + 1)]. The foot
 # (4 x 2 cm, yaw 0) has the 3 x 3 stencil, so the outer ring (its stencil leaves the map) is size increase and
 # only the inner 3 x 3 cells can be footprints. Tolerances: HAND_TOL on every hand number.
+def _minmod(forward, backward):
+    """The one-sided difference of the smaller size, 0 where the two differ in sign (the documented slope)."""
+    return 0.0 if forward * backward <= 0 else min(forward, backward, key=abs)
+
+
 HAND_TOL = 1e-9
 HAND_CONFIG = PlannerConfig(cell_size=0.1, obstacle_margin_m=0.0)
 FOOT = dict(foot_length=0.04, foot_width=0.02, foot_yaw=0.0)
@@ -1047,17 +1052,17 @@ def test_hand_footprint_terms():
     assert (h.cand_xyz[k, 0], h.cand_xyz[k, 2]) == (0.27, 0.33)
     # distance:   |P - P| = 0                                             -> 1 - 0 / 0.30 = 1
     # elevation:  dilated 0.03 here; raw neighbours 0 but (3, 3) = 0.03: max |dh| = 0.03 -> 1 - 0.03 / 0.12 = 0.75
-    # slope:      gx = (e(3, 3) - e(3, 1)) / 0.2 = (0.03 - 0) / 0.2 = 0.15, gz = (e(4, 2) - e(2, 2)) / 0.2 = 0,
-    #             atan(0.15) = 0.14888994760949725 rad          -> 1 - 0.14888994760949725 = 0.8511100523905027
+    # slope:      one-sided differences (minmod): along x e(3, 3) - e(3, 2) = 0 and e(3, 2) - e(3, 1) = 0.03, so 0
+    #             (the box's edge is beside the foot, not under it); along z 0 and 0          -> 0 rad -> 1
     # leg gap:    P to the other leg (its nearest point is its foot): hypot(0.18, 0.05) = sqrt(0.0349)
     #             = 0.18681541692269404 (the other foot to hip -> P: the same point) -> / 0.25 = 0.7472616676907762
     # proximity:  one cell to the size-increase ring cell (4, 2): 0.1 m  -> 0.1 / 0.25 = 0.4
-    np.testing.assert_allclose(h.cand_features[k], [0.0, 0.03, 0.14888994760949725, 0.18681541692269404, 0.1],
+    np.testing.assert_allclose(h.cand_features[k], [0.0, 0.03, 0.0, 0.18681541692269404, 0.1],
                                rtol=0, atol=HAND_TOL)
-    np.testing.assert_allclose(h.cand_terms[k], [1.0, 0.75, 0.8511100523905027, 0.7472616676907762, 0.4],
+    np.testing.assert_allclose(h.cand_terms[k], [1.0, 0.75, 1.0, 0.7472616676907762, 0.4],
                                rtol=0, atol=HAND_TOL)
-    # footprint score, weights 3, 1, 1, 1, 1: (3 * 1 + 0.75 + 0.85111005239 + 0.74726166769 + 0.4) / 7
-    assert h.cand_scores[k] == pytest.approx(0.8211959600116113, abs=HAND_TOL)
+    # footprint score, weights 3, 1, 1, 1, 1: (3 * 1 + 0.75 + 1 + 0.74726166769 + 0.4) / 7
+    assert h.cand_scores[k] == pytest.approx(0.8424659525384395, abs=HAND_TOL)
 
     k = _row(h, (1, 1))  # square [0.1, 0.2]^2, P beyond both edges: the footprint is the corner (0.2, 0.2).
     assert (h.cand_xyz[k, 0], h.cand_xyz[k, 2]) == (0.2, 0.2)
@@ -1075,16 +1080,38 @@ def test_hand_footprint_terms():
     k = _row(h, (2, 2))  # square [0.2, 0.3]^2: the footprint is (0.27, 0.30), on its top edge.
     # distance:   0.33 - 0.30 = 0.03                                      -> 1 - 0.03 / 0.3 = 0.9
     # elevation:  dilated 0.03; raw neighbours 0 (but (3, 3)): 0.03   -> 0.75
-    # slope:      gx = (e(2, 3) - e(2, 1)) / 0.2 = 0.15, gz = (e(3, 2) - e(1, 2)) / 0.2 = 0.15,
-    #             atan(0.15 sqrt 2) = 0.20903329903452011              -> 0.7909667009654799
+    # slope:      minmod(e(2, 3) - e(2, 2), e(2, 2) - e(2, 1)) = minmod(0, 0.03) = 0, and along z
+    #             minmod(e(3, 2) - e(2, 2), e(2, 2) - e(1, 2)) = minmod(0, 0.03) = 0     -> 0 rad -> 1
     # leg gap:    hypot(0.18, 0.08) = sqrt(0.0388) = 0.19697715603592209 -> / 0.25 = 0.7879086241436883
     # proximity:  one cell to the size increase (2, 3)                 -> 0.4
-    np.testing.assert_allclose(h.cand_features[k], [0.03, 0.03, 0.20903329903452011, 0.19697715603592209, 0.1],
+    np.testing.assert_allclose(h.cand_features[k], [0.03, 0.03, 0.0, 0.19697715603592209, 0.1],
                                rtol=0, atol=HAND_TOL)
-    np.testing.assert_allclose(h.cand_terms[k], [0.9, 0.75, 0.7909667009654799, 0.7879086241436883, 0.4],
+    np.testing.assert_allclose(h.cand_terms[k], [0.9, 0.75, 1.0, 0.7879086241436883, 0.4],
                                rtol=0, atol=HAND_TOL)
-    # (3 * 0.9 + 0.75 + 0.79096670097 + 0.78790862414 + 0.4) / 7
-    assert h.cand_scores[k] == pytest.approx(0.7755536178727384, abs=HAND_TOL)
+    # (3 * 0.9 + 0.75 + 1 + 0.78790862414 + 0.4) / 7
+    assert h.cand_scores[k] == pytest.approx(0.8054155177348126, abs=HAND_TOL)
+
+
+def test_hand_footprint_slope_is_the_ground_under_the_foot_not_a_step_beside_it():
+    # The slope feature takes, per axis, the smaller of the dilated elevation's two one-sided differences
+    # when they agree in sign, else 0 (minmod). On a ramp rising 2 cm a cell along x, the dilated
+    # elevation (3 x 3 max) is 0.02 * min(c + 1, 4): at (2, 1) and (2, 2) both differences are 0.02, so
+    # gx = 0.02 / 0.1 = 0.2 and the slope is atan(0.2), what a central difference gives too.
+    # Beside a 3 cm step (columns 3 and 4), the dilated elevation is 0, 0, 0.03, 0.03, 0.03 along a row:
+    # at (2, 1) and (2, 2) one difference is 0, so no slope; a central difference saw 0.15 there, and an
+    # ant on stairs (4 cm cells, 7 cm strides) kept its feet three cells off every riser, a third of its
+    # strides off the law next to each (stairs, 6 ants, p90 0.31-0.35). The step is the roughness's.
+    query = FootQuery(source=(0.25, 0.0, 0.15), preferred=(0.25, 0.25), hip=(0.25, 0.15), reach_xz=0.7,
+                      step_height=0.05, **FOOT)
+    ramp = np.tile(0.02 * np.arange(5.0), (5, 1))
+    h = harvest_foot(_hand_maps(ramp, np.zeros((5, 5))), query, budget=EXHAUSTIVE, config=HAND_CONFIG)
+    for cell in ((2, 1), (2, 2)):
+        assert h.cand_features[_row(h, cell), 2] == pytest.approx(math.atan(0.2), abs=HAND_TOL)
+    step = np.zeros((5, 5))
+    step[:, 3:] = 0.03
+    h = harvest_foot(_hand_maps(step, np.zeros((5, 5))), query, budget=EXHAUSTIVE, config=HAND_CONFIG)
+    assert h.cand_features[_row(h, (2, 1)), 2] == 0.0 and h.cand_features[_row(h, (2, 2)), 2] == 0.0
+    assert h.cand_features[_row(h, (2, 2)), 1] == pytest.approx(0.03, abs=HAND_TOL)  # raw (2, 1) = 0 beside it
 
 
 def test_hand_trajectory_terms():
@@ -1116,14 +1143,13 @@ def test_hand_trajectory_terms():
     assert abs(raw["curvature"]) <= HAND_TOL and abs(raw["jerk"]) <= HAND_TOL
     assert raw["clearance"] == pytest.approx(0.1, abs=HAND_TOL) and raw["climb"] == 0.0
     np.testing.assert_allclose(h.couple_terms[k, 1, 5:], [1.0, 1.0, 0.4, 1.0, 1.0], rtol=0, atol=HAND_TOL)
-    # Footprint terms of (2, 2): distance 0 -> 1; flat around -> roughness 0 -> 1; slope: gz = (e(3, 2) - e(1, 2)) / 0.2
-    # = (0 - 0.02) / 0.2 = -0.1, atan(0.1) = 0.09966865249116204 -> 0.9003313475088379; no other leg -> 1;
-    # two cells to the ring (0.2 m) -> 0.8. Footprint score (3 + 1 + 0.90033134751 + 1 + 0.8) / 7 = 0.9571901925012626;
+    # Footprint terms of (2, 2): distance 0 -> 1; flat around -> roughness 0 -> 1; slope: along z minmod(e(3, 2) -
+    # e(2, 2), e(2, 2) - e(1, 2)) = minmod(0, -0.02) = 0 (the raised cells are beside the foot) -> 1; no other leg
+    # -> 1; two cells to the ring (0.2 m) -> 0.8. Footprint score (3 + 1 + 1 + 1 + 0.8) / 7 = 0.9714285714285714;
     # trajectory score (weights 2, 1, 0.5, 1, 0.5): (2 + 1 + 0.5 * 0.4 + 1 + 0.5) / 5 = 0.94;
-    # couple score (6.70033134751 + 4.7) / 12 = 0.9500276122924033.
-    np.testing.assert_allclose(h.couple_terms[k, 1, :5], [1.0, 1.0, 0.9003313475088379, 1.0, 0.8], rtol=0,
-                               atol=HAND_TOL)
-    np.testing.assert_allclose(h.couple_scores[k, 1], [0.9500276122924033, 0.9571901925012626, 0.94], rtol=0,
+    # couple score (6.8 + 4.7) / 12 = 0.9583333333333334.
+    np.testing.assert_allclose(h.couple_terms[k, 1, :5], [1.0, 1.0, 1.0, 1.0, 0.8], rtol=0, atol=HAND_TOL)
+    np.testing.assert_allclose(h.couple_scores[k, 1], [0.9583333333333334, 0.9714285714285714, 0.94], rtol=0,
                                atol=HAND_TOL)
     # Slice +inf: the raised cells of row 1 are passable, so every sample's 3 x 3 block reaches a 0.02 m cell:
     # climb = 0.02 - (max(0, 0) + 0) = 0.02 -> 1 / (1 + 0.02 / 0.10) = 0.8333333333333334. Clearance: the samples
@@ -1202,6 +1228,28 @@ def test_drawn_heights_keep_a_swing_under_a_ceiling_over_forbidden_cells_only():
     assert out.tolist() == [[0.0, 0.0, 0.0], [1.0, 0.0, 0.1], [2.0, 0.0, 0.25], [3.0, 0.0, 0.3]]
     assert not drawn_heights(dense, dense[:, 2].copy(), 4, 0.1, out)  # nothing from a forbidden box
     assert out.tolist() == dense.tolist()
+
+
+def test_a_foot_beside_a_forbidden_wall_goes_around_it_not_through_it():
+    # 16 x 16 cells of 7 cm, flat; a forbidden wall fills rows 4-11 of columns 7-8 (x in [0.49, 0.63],
+    # z in [0.28, 0.84]). The foot stands at the centre of (7, 6) = (0.455, 0.525): its stencil touches
+    # column 7, so its cell is a size-increase one (blocked) and the swing leaves through the blocked
+    # region around it. Its footprint lies across the wall, near (0.805, 0.525). The way out is the
+    # cells beside the wall; the wall's own cells were opened too, and the swing went straight through
+    # it (a far spider's foot cut a static crate's corner: 1000 spiders, mixed, seed 1).
+    n, cell = 16, 0.07
+    forbidden = np.zeros((n, n), np.uint8)
+    forbidden[4:12, 7:9] = 1
+    elevation = np.where(forbidden == 1, 0.3, 0.0)
+    maps = LocalMaps(GridFrame(0.0, 0.0, cell, n, n), elevation, np.zeros((n, n)), forbidden)
+    query = FootQuery(source=(0.455, 0.0, 0.525), preferred=(0.805, 0.525), hip=(0.63, 0.525), reach_xz=0.7,
+                      step_height=0.05, foot_length=0.03, foot_width=0.02, foot_yaw=0.0)
+    result = plan_foot(maps, query, budget=EXHAUSTIVE)
+    assert result.valid
+    assert result.target[0] > 0.63
+    rows = np.floor(result.trajectory[:, 2] / cell).astype(int)
+    cols = np.floor(result.trajectory[:, 0] / cell).astype(int)
+    assert not forbidden[rows, cols].any(), result.trajectory[forbidden[rows, cols] == 1]
 
 
 @pytest.mark.parametrize("box_height", [0.25, 0.4])

@@ -127,6 +127,15 @@ def random_query(rng, maps):
     return q, inflated
 
 
+def _distance_to_segment(point, leg):
+    """Ground distance from ``point`` (x, z) to a leg (hip_x, hip_z, foot_x, foot_z), hip -> foot."""
+    hx, hz, fx, fz = leg
+    dx, dz = fx - hx, fz - hz
+    ll = dx * dx + dz * dz
+    t = 1.0 if ll == 0 else min(1.0, max(0.0, ((point[0] - hx) * dx + (point[1] - hz) * dz) / ll))
+    return math.hypot(point[0] - hx - t * dx, point[1] - hz - t * dz)
+
+
 def check_couple(result, query, maps, boxes, inflated):
     if not result.valid:
         np.testing.assert_array_equal(result.target, query.source)
@@ -136,11 +145,20 @@ def check_couple(result, query, maps, boxes, inflated):
     np.testing.assert_array_equal(traj[-1], result.target)
     tr, tc = result.target_cell
     assert not maps.forbidden[tr, tc] and not inflated[tr, tc], "footprint on a forbidden or size-increase cell"
-    # A continuous footprint: the point of the target cell nearest the preferred footprint.
+    # A continuous footprint: the point of the target cell nearest the preferred footprint, or, where that
+    # point is within a foot's room of another foot or leg, a point of the cell's closed square pushed
+    # out of that room (planner._kernels_foot.out_of_other_feet).
     cx, cz = maps.frame.cell_to_world(tr, tc)
     half = 0.5 * maps.frame.cell_size
     px, pz = query.preferred
-    assert (min(max(px, cx - half), cx + half), min(max(pz, cz - half), cz + half)) == (result.target[0], result.target[2])
+    nearest = (min(max(px, cx - half), cx + half), min(max(pz, cz - half), cz + half))
+    tx, tz = result.target[0], result.target[2]
+    if nearest != (tx, tz):
+        room = query.feet_block_radius
+        legs = query.other_legs
+        assert any(_distance_to_segment(nearest, leg) <= room for leg in legs), "a footprint moved off the cell's nearest point"
+        assert abs(tx - cx) <= half + 1e-12 and abs(tz - cz) <= half + 1e-12, "a pushed footprint left its cell"
+        assert all(math.hypot(tx - leg[2], tz - leg[3]) > room for leg in legs), "a pushed footprint in a foot's room"
     half_foot = (0.5 * query.foot_length, 0.5 * query.foot_width)
     for cx, cy, cz, sx, h, sz, yaw, is_forbidden in boxes:
         top = cy + 0.5 * h
