@@ -520,6 +520,20 @@ def test_a_tuck_point_inside_a_box_moves_in_to_the_first_clear_one(tmp_path):
     np.testing.assert_allclose(tuck_points(model, state, chars, legs, hips), at(TUCK_REACHES[0]), atol=1e-12)
 
 
+def _every_plan_fails(monkeypatch):
+    """From now on every foot planned finds no valid couple (a foot walled in)."""
+    import footfall.planner._crowd as crowd
+
+    original = crowd._plan_groups
+
+    def no_footprint(*args, **kwargs):
+        out, groups = original(*args, **kwargs)
+        out.valid[:] = False
+        return out, groups
+
+    monkeypatch.setattr(crowd, "_plan_groups", no_footprint)
+
+
 def _escape_step_without_footprints(tmp_path, monkeypatch, escaping, prepare):
     """A spider standing still with every foot down, facing +x, its goal ahead; ``prepare(model, state,
     hips)`` sets up one left front foot and returns its leg. Then one frame in which the steering says
@@ -541,14 +555,8 @@ def _escape_step_without_footprints(tmp_path, monkeypatch, escaping, prepare):
     def lane_exit(model, state, direction, boxes, box_velocity):
         return np.array([[0.0, 1.0]]), np.array([escaping])
 
-    def no_footprint(*args, **kwargs):
-        out, groups = original(*args, **kwargs)
-        out.valid[:] = False
-        return out, groups
-
-    original = crowd._plan_groups
     monkeypatch.setattr(crowd, "_lane_exit", lane_exit)
-    monkeypatch.setattr(crowd, "_plan_groups", no_footprint)
+    _every_plan_fails(monkeypatch)
     # At the asked speed: asked for its flee speed from standing, another leg's look-ahead fails too
     # (it cannot follow the body), and that foot, the worse, steps first: the case is the one foot.
     monkeypatch.setattr(crowd, "FLEE_SPEED", 0.0)
@@ -611,7 +619,6 @@ def test_a_foot_past_its_window_that_finds_no_footprint_is_tucked_once_it_has_he
     # walled in). The body stands, so the gait's needle stands and no other foot lifts: before, it stood
     # for good (crates, 8 spiders, seed 1: 13 s). The foot holds the body STALL_FRAMES - 1 frames; in the
     # next it is tucked, and the body walks on.
-    import footfall.planner._crowd as crowd
     from footfall.planner._crowd import STALL_FRAMES, stance_room
 
     model, state = _world(tmp_path, "stall", crate_centre=(5.0, 5.0), crate_width=0.2, start=(0.0, 0.0),
@@ -626,14 +633,7 @@ def test_a_foot_past_its_window_that_finds_no_footprint_is_tucked_once_it_has_he
     leg = int(rear[np.argmin(model.hips_body[rear, 0])])
     state.feet[0, leg, 0] = state.pelvis[0, 0] + model.stance_window[leg, 0] - 0.02
     assert stance_room(model, state)[0, leg] < 0.0  # premise
-
-    def no_footprint(*args, **kwargs):
-        out, groups = original(*args, **kwargs)
-        out.valid[:] = False
-        return out, groups
-
-    original = crowd._plan_groups
-    monkeypatch.setattr(crowd, "_plan_groups", no_footprint)
+    _every_plan_fails(monkeypatch)
     for _ in range(STALL_FRAMES - 1):
         step(model, state)
         assert state.speed[0] == 0.0 and not state.tucked[0].any()
