@@ -402,8 +402,6 @@ class CrowdState:
     goal_speed: np.ndarray  # (C,) m/s: the speed the last steer stage headed for (0 at the goal; braking before it)
     speed_wanted: np.ndarray  # (C,) m/s: the speed the last steer stage asked after turns, avoidance and limits
     blocks_escape: np.ndarray  # (C, L) bool: a stance foot that stops an escaping character's turn
-    stalled_frames: np.ndarray  # (C,) int: frames in a row the body stood still with a goal speed
-    stalls_body: np.ndarray  # (C, L) bool: a stance foot past its window's rear end holding a stalled body
     crossed: np.ndarray  # (C, L, L) bool: pairs of stance legs drawn crossed at the end of the last frame
     counters: dict = field(default_factory=dict)
     lod_level: np.ndarray | None = None  # (C,) int8: each character's level of detail (planner._lod, LEVEL_*)
@@ -617,7 +615,6 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
     # its heading, and a walker still turning toward its preferred velocity walked into a spider
     # standing in its way (1000 spiders, mixed, seed 2: 122 overlapping frames).
     state.speed[~bodies_apart(model, state, fwd * (state.speed * dt)[:, None], neighbours)] = 0.0
-    state.stalled_frames = np.where((state.speed <= 0.0) & (state.goal_speed > 0.0), state.stalled_frames + 1, 0)
     state.last_move = fwd * (state.speed * dt)[:, None]
     state.pelvis[:, [0, 2]] += state.last_move
     # Feet feedback (§3.2): a significant mean offset between preferred and chosen footprints moves the pelvis.
@@ -1346,11 +1343,6 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, fre
     # spider's three right legs planned no footprint for 25 frames, holding the body in the lane until
     # the crate ran over them (mixed, 8 spiders, seed 28: 161 foot-frames in the crate).
     state.blocks_escape = (stops_turn | cannot_follow) & state.escaping[:, None]
-    # So does a foot past the rear end of its window that has held the body still for STALL_FRAMES:
-    # the body stands, so the gait's needle stands too and no other foot lifts to change what walls
-    # the foot in; a spider on `crates` stood 13 s with every foot down, one past its window with no
-    # couple, re-planned and held every frame (8 spiders, seed 1, frames 215-605).
-    state.stalls_body = (room <= 0.0) & (goal > 0.0) & (state.stalled_frames >= STALL_FRAMES)[:, None]
     # So does a stance leg the turn asked would carry across another (uncrossing_turn holds the turn).
     far |= turn_crossed_legs(model, state, state.turn_wanted)
     # A stance foot the body turned across another leg steps (its own side again).
@@ -1650,8 +1642,7 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     # every forced step left without a footprint, as a way out of holds, crossed spiders' adjacent
     # legs on the straight way in: 29 -> 51 crossings, crates-moving, 4 runs of 12 x 600 frames.)
     state.tucked[vc, vl] = False
-    tuck = ~out.valid & ((new & (state.threatened | state.blocks_escape | state.stalls_body)[cs, ls])
-                         | state.tucked[cs, ls])
+    tuck = ~out.valid & ((new & (state.threatened | state.blocks_escape)[cs, ls]) | state.tucked[cs, ls])
     if tuck.any():
         # A new tuck is a flinch (TUCK_FRAMES); a tucked foot whose re-plan fails goes on as it was.
         left = np.where(new, TUCK_FRAMES * model.dt, state.swing_T[cs, ls] - state.swing_t[cs, ls])
@@ -1667,11 +1658,6 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     state.counters["couples_evaluated"] += int(out.counters[:, 0].sum())
     return batch, out, cs, ls, calls
 
-
-STALL_FRAMES = 30
-"""Frames a body stands still, held by a stance foot past its window with no footprint, before that foot
-is tucked (stage_requests: ``stalls_body``); a second. Tucking every such foot at once crossed legs
-(stage_plan's note)."""
 
 TUCK_REACH = 0.25
 """x the rest foot's offset from its hip: how far out a tucked foot is held (tuck_swings)."""
@@ -2300,8 +2286,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         ik_on=np.zeros(n, np.bool_), fk_feet=feet.copy(), pelvis_base=np.zeros(n), pelvis_rise=np.zeros(n), body_held=np.zeros(n, np.bool_), speed_limit=np.full(n, np.inf), last_move=np.zeros((n, 2)), cannot_follow=np.zeros((n, L), np.bool_), unfollowed=np.zeros((n, L), np.bool_), pose_before=np.zeros((n, 7)),
         gait_index=gait_index, stride_frequency=np.zeros(n), turn_wanted=np.zeros(n),
         threatened=np.zeros((n, L), np.bool_), tucked=np.zeros((n, L), np.bool_),
-        escaping=np.zeros(n, np.bool_), goal_speed=np.full(n, speed), speed_wanted=np.zeros(n), blocks_escape=np.zeros((n, L), np.bool_),
-        stalled_frames=np.zeros(n, np.int64), stalls_body=np.zeros((n, L), np.bool_), crossed=np.zeros((n, L, L), np.bool_),
+        escaping=np.zeros(n, np.bool_), goal_speed=np.full(n, speed), speed_wanted=np.zeros(n), blocks_escape=np.zeros((n, L), np.bool_), crossed=np.zeros((n, L, L), np.bool_),
         counters={k: 0 for k in ("steps", "plans", "holds", "replans", "forbidden_footprints", "cells_expanded",
                                  "couples_evaluated", "pose_takebacks", "crossing_takebacks", "map_cells_built", "ik_ccd_legs", "ik_two_bone_legs")},
         lod_level=np.full(n, LEVEL_FULL, np.int8), near_moving_box=np.zeros(n, np.bool_),

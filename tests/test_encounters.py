@@ -612,40 +612,6 @@ def test_a_foot_its_leg_cannot_follow_that_finds_no_footprint_is_tucked_when_esc
     assert state.in_stance[0, leg] and not state.tucked[0].any() and state.counters["holds"] > 0
 
 
-def test_a_foot_past_its_window_that_finds_no_footprint_is_tucked_once_it_has_held_the_body_a_second(
-        tmp_path, monkeypatch):
-    # A spider standing with every foot down, its goal ahead; its left rear foot stands 2 cm past the rear
-    # end of its leg's stance window (room < 0: it caps the body at 0), and every plan fails (the foot is
-    # walled in). The body stands, so the gait's needle stands and no other foot lifts: before, it stood
-    # for good (crates, 8 spiders, seed 1: 13 s). The foot holds the body STALL_FRAMES - 1 frames; in the
-    # next it is tucked, and the body walks on.
-    from footfall.planner._crowd import STALL_FRAMES, stance_room
-
-    model, state = _world(tmp_path, "stall", crate_centre=(5.0, 5.0), crate_width=0.2, start=(0.0, 0.0),
-                          goal=(0.0, 0.0))
-    for _ in range(30):  # every foot down
-        step(model, state)
-    state.heading[:] = 0.0
-    state.route[0] = [4.0, 0.0]
-    state.in_stance[0] = True
-    state.wants_swing[0] = False
-    rear = np.flatnonzero(model.hips_body[:, 2] > 0)
-    leg = int(rear[np.argmin(model.hips_body[rear, 0])])
-    state.feet[0, leg, 0] = state.pelvis[0, 0] + model.stance_window[leg, 0] - 0.02
-    assert stance_room(model, state)[0, leg] < 0.0  # premise
-    _every_plan_fails(monkeypatch)
-    for _ in range(STALL_FRAMES - 1):
-        step(model, state)
-        assert state.speed[0] == 0.0 and not state.tucked[0].any()
-    moved = []
-    for _ in range(10):
-        step(model, state)
-        moved.append(float(state.speed[0]))
-    assert state.tucked[0, leg] and not state.in_stance[0, leg]
-    assert not np.delete(state.tucked[0], leg).any()  # only the foot that holds the body
-    assert max(moved) > 0.0
-
-
 @pytest.mark.parametrize("neighbour", [False, True])
 def test_an_escape_whose_orca_velocity_points_back_turns_to_the_lane_exits_side(tmp_path, monkeypatch, neighbour):
     # A spider standing dead centre in the lane of a 0.6 m crate that comes at it along -x, facing it
