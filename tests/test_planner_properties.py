@@ -127,15 +127,6 @@ def random_query(rng, maps):
     return q, inflated
 
 
-def _distance_to_segment(point, leg):
-    """Ground distance from ``point`` (x, z) to a leg (hip_x, hip_z, foot_x, foot_z), hip -> foot."""
-    hx, hz, fx, fz = leg
-    dx, dz = fx - hx, fz - hz
-    ll = dx * dx + dz * dz
-    t = 1.0 if ll == 0 else min(1.0, max(0.0, ((point[0] - hx) * dx + (point[1] - hz) * dz) / ll))
-    return math.hypot(point[0] - hx - t * dx, point[1] - hz - t * dz)
-
-
 def check_couple(result, query, maps, boxes, inflated):
     if not result.valid:
         np.testing.assert_array_equal(result.target, query.source)
@@ -156,7 +147,7 @@ def check_couple(result, query, maps, boxes, inflated):
     if nearest != (tx, tz):
         room = query.feet_block_radius
         legs = query.other_legs
-        assert any(_distance_to_segment(nearest, leg) <= room for leg in legs), "a footprint moved off the cell's nearest point"
+        assert any(point_segment_distance(nearest, leg[:2], leg[2:]) <= room for leg in legs), "a footprint moved off the cell's nearest point"
         assert abs(tx - cx) <= half + 1e-12 and abs(tz - cz) <= half + 1e-12, "a pushed footprint left its cell"
         assert all(math.hypot(tx - leg[2], tz - leg[3]) > room for leg in legs), "a pushed footprint in a foot's room"
     half_foot = (0.5 * query.foot_length, 0.5 * query.foot_width)
