@@ -12,6 +12,8 @@ import math
 import numba as nb
 import numpy as np
 
+from footfall.planner.layout import FORBIDDEN_STATIC
+
 
 @nb.njit(cache=True)
 def rect_overlaps_aabb(cx, cz, hx, hz, yaw, ax, az, ahx, ahz):
@@ -40,9 +42,10 @@ def rect_overlaps_aabb(cx, cz, hx, hz, yaw, ax, az, ahx, ahz):
 
 @nb.njit(cache=True)
 def rasterise_boxes(top, forbidden, origin_x, origin_z, cell, centres, sizes, yaws, box_forbidden, selected,
-                    mark=1):
+                    mark=FORBIDDEN_STATIC):
     """Voxelise boxes onto a grid: raise ``top`` to each box's top and flag forbidden cells
-    (``forbidden`` set to ``mark``: :data:`planner.layout.FORBIDDEN_MOVING` for moving boxes).
+    (``forbidden`` set to ``mark``: :data:`planner.layout.FORBIDDEN_STATIC`, or ``FORBIDDEN_MOVING`` for
+    moving boxes).
 
     A cell is covered when its square overlaps the box's footprint (conservative,
     rotated boxes included). Only boxes with ``selected[i]`` are drawn.

@@ -14,7 +14,7 @@ import numba as nb
 import numpy as np
 
 from footfall.planner._kernels_geometry import rasterise_boxes, rect_overlaps_aabb
-from footfall.planner.layout import FORBIDDEN_MOVING
+from footfall.planner.layout import FORBIDDEN_MOVING, FORBIDDEN_STATIC
 
 
 @nb.njit(cache=True)
@@ -34,7 +34,7 @@ def _window(ground, static_top, static_forbidden, g_origin_x, g_origin_z, cell, 
             out_ground[r, c] = ground[grc, gcc]
             out_elev[r, c] = static_top[grc, gcc]
             if gr < 0 or gr >= n_rows or gc < 0 or gc >= n_cols:
-                out_forb[r, c] = 1
+                out_forb[r, c] = FORBIDDEN_STATIC
             else:
                 out_forb[r, c] = static_forbidden[grc, gcc]
     ox = g_origin_x + gc0 * cell
@@ -83,7 +83,7 @@ def _stamp_rect(forb, ox, oz, cell, cx, cz, hx, hz, yaw):
         for c in range(c0, c1 + 1):
             ax = ox + (c + 0.5) * cell
             if rect_overlaps_aabb(cx, cz, hx, hz, yaw, ax, az, 0.5 * cell, 0.5 * cell):
-                forb[r, c] = 1
+                forb[r, c] = FORBIDDEN_STATIC
 
 
 @nb.njit(cache=True, parallel=True)

@@ -19,7 +19,7 @@ import numpy as np
 
 from footfall.planner._grid import GridFrame
 from footfall.planner._kernels_geometry import rasterise_boxes
-from footfall.planner.layout import FORBIDDEN_MOVING
+from footfall.planner.layout import FORBIDDEN_MOVING, FORBIDDEN_STATIC
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:
@@ -215,8 +215,8 @@ class WorldRaster:
         forbidden = self.static_forbidden[np.ix_(rows, cols)].copy()
         outside_r = (np.arange(gr0, gr0 + map_cells) < 0) | (np.arange(gr0, gr0 + map_cells) >= f.n_rows)
         outside_c = (np.arange(gc0, gc0 + map_cells) < 0) | (np.arange(gc0, gc0 + map_cells) >= f.n_cols)
-        forbidden[outside_r, :] = 1
-        forbidden[:, outside_c] = 1
+        forbidden[outside_r, :] = FORBIDDEN_STATIC
+        forbidden[:, outside_c] = FORBIDDEN_STATIC
         obstacles = self.obstacles
         if len(obstacles.yaws):
             moving = ~np.asarray(obstacles.is_static, dtype=np.bool_)
