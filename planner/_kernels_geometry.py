@@ -45,7 +45,7 @@ def rasterise_boxes(top, forbidden, origin_x, origin_z, cell, centres, sizes, ya
                     mark=FORBIDDEN_STATIC):
     """Voxelise boxes onto a grid: raise ``top`` to each box's top and flag forbidden cells
     (``forbidden`` set to ``mark``: :data:`planner.layout.FORBIDDEN_STATIC`, or ``FORBIDDEN_MOVING`` for
-    moving boxes).
+    moving boxes; a cell already static stays static).
 
     A cell is covered when its square overlaps the box's footprint (conservative,
     rotated boxes included). Only boxes with ``selected[i]`` are drawn.
@@ -74,7 +74,9 @@ def rasterise_boxes(top, forbidden, origin_x, origin_z, cell, centres, sizes, ya
                 if rect_overlaps_aabb(cx, cz, hx, hz, yaw, ax, az, half, half):
                     if box_top > top[r, c]:
                         top[r, c] = box_top
-                    if box_forbidden[i]:
+                    # A static mark stands: a moving box drawn over a static one's cells must not make
+                    # them a way out of a moving box (planner._kernels_foot._open_escape).
+                    if box_forbidden[i] and forbidden[r, c] != FORBIDDEN_STATIC:
                         forbidden[r, c] = mark
 
 
