@@ -199,6 +199,7 @@ def test_the_run_loss_is_its_formula(one_run):
                                                  + COLLISION_PENALTY)
     # A style's hinges: 0 when met, log ratio when not, each in its direction.
     m["near_box_share"] = 0.1
+    m["touchdown_slope_rad"] = 0.08  # the run's own is 0 on 1 cm risers; a style's bound is > 0
     style = {"min_clearance_body_heights": 1.0, "max_touchdown_slope_rad": 0.5 * m["touchdown_slope_rad"],
              "min_distance_ratio": 0.5 * m["distance_ratio"]}
     terms = style_terms(m, style)
