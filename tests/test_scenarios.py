@@ -608,11 +608,12 @@ def test_a_bad_variant_names_the_field(spec, field):
     assert field in info.value.field and spec.split("@")[0] in str(info.value)
 
 
-def test_an_ant_foot_before_a_riser_of_the_builtin_stairs_lands_where_it_prefers(scenario_name="stairs"):
+def test_an_ant_foot_before_a_riser_of_the_builtin_stairs_lands_where_it_prefers():
     # The first riser is at x = -2.0, the lower tread at height 0. An ant foot 10 cm before it prefers a
     # footprint 3.5 cm before it (a 6.5 cm stride; the ant's planner cells are 4 cm, cell [-2.04, -2.0) the
     # last before the riser). A heightfield ramps a riser over one of its cells: at the built-in 1 cm the
-    # cell [-2.08, -2.04) is flat and the foot lands in it, on the tread, within a cell of its preference.
+    # cell [-2.08, -2.04) is flat and the foot lands in it, on the tread, within a quarter cell of its
+    # preference.
     # At 2.5 cm the ramp (-2.025 to -2.0) raised the sample of the cell before the riser to 1.4 cm, the
     # dilation made the next cell back slope 0.34 rad: the foot landed a cell short (-2.08; in the crowd, also
     # on the riser's dilated top, 7 cm up in the air beside it), and the ant's strides across every riser
@@ -620,7 +621,7 @@ def test_an_ant_foot_before_a_riser_of_the_builtin_stairs_lands_where_it_prefers
     from footfall.planner import FootQuery, WorldRaster, plan_foot
     from footfall.planner._crowd import planner_config_for
 
-    scenario = scenarios.load_scenario(scenario_name)
+    scenario = scenarios.load_scenario("stairs")
     ant = scenarios.load_creature("ant")
     config = planner_config_for(ant)
     world = WorldRaster.build(scenario.terrain, scenario.obstacles, config.cell_size)
@@ -630,4 +631,4 @@ def test_an_ant_foot_before_a_riser_of_the_builtin_stairs_lands_where_it_prefers
     result = plan_foot(maps, query, config=config)
     assert result.valid
     on_tread = result.target[1] == 0.0 and abs(result.target[0] + 2.035) <= config.cell_size / 4
-    assert on_tread, f"{scenario_name}: the foot lands at {result.target.round(3)}"
+    assert on_tread, f"the foot lands at {result.target.round(3)}"
