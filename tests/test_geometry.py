@@ -75,17 +75,17 @@ def test_a_moving_box_drawn_over_a_static_one_leaves_its_cells_static():
     # Static 2 x 1 box over cells (1, 1), (1, 2); a moving 2 x 1 box over (1, 2), (1, 3) drawn after it:
     # the shared cell (1, 2) stays FORBIDDEN_STATIC (1), only (1, 3) is FORBIDDEN_MOVING (2). A static
     # box drawn after the moving one makes its cells static again.
-    from footfall.planner.layout import FORBIDDEN_MOVING
+    from footfall.planner.layout import FORBIDDEN_MOVING, FORBIDDEN_STATIC
 
     def draw(forbidden, centre_x, mark):
         rasterise_boxes(np.zeros((3, 5)), forbidden, 0.0, 0.0, 1.0, np.array([[centre_x, 0.5, 1.5]]),
                         np.array([[1.8, 1.0, 0.8]]), np.array([0.0]), np.array([True]), np.array([True]), mark)
 
     forbidden = np.zeros((3, 5), np.uint8)
-    draw(forbidden, 2.0, 1)
+    draw(forbidden, 2.0, FORBIDDEN_STATIC)
     draw(forbidden, 3.0, FORBIDDEN_MOVING)
     np.testing.assert_array_equal(forbidden, [[0, 0, 0, 0, 0], [0, 1, 1, 2, 0], [0, 0, 0, 0, 0]])
-    draw(forbidden, 3.0, 1)
+    draw(forbidden, 3.0, FORBIDDEN_STATIC)
     np.testing.assert_array_equal(forbidden, [[0, 0, 0, 0, 0], [0, 1, 1, 1, 0], [0, 0, 0, 0, 0]])
 
 
