@@ -223,6 +223,11 @@ def cells_walked(ax, az, bx, bz, ox, oz, cell):
     return out
 
 
+def _minmod(forward, backward):
+    """The one-sided difference of the smaller size, 0 where the two differ in sign (the documented slope)."""
+    return 0.0 if forward * backward <= 0 else min(forward, backward, key=abs)
+
+
 def octile_distance_map(seeds, cell):
     """Distance (m) from each cell centre to the nearest seed cell centre in the chamfer metric the
     runtime documents (steps of 1 and sqrt 2 cells: octile distance); inf without seeds."""
@@ -1013,11 +1018,6 @@ def test_a_leg_over_a_boxs_ring_does_not_hide_the_box():
 # Cells of 10 cm, origin (0, 0): cell (r, c) spans x in [0.1 c, 0.1 (c + 1)], z in [0.1 r, 0.1 (r + 1)]. The foot
 # (4 x 2 cm, yaw 0) has the 3 x 3 stencil, so the outer ring (its stencil leaves the map) is size increase and
 # only the inner 3 x 3 cells can be footprints. Tolerances: HAND_TOL on every hand number.
-def _minmod(forward, backward):
-    """The one-sided difference of the smaller size, 0 where the two differ in sign (the documented slope)."""
-    return 0.0 if forward * backward <= 0 else min(forward, backward, key=abs)
-
-
 HAND_TOL = 1e-9
 HAND_CONFIG = PlannerConfig(cell_size=0.1, obstacle_margin_m=0.0)
 FOOT = dict(foot_length=0.04, foot_width=0.02, foot_yaw=0.0)

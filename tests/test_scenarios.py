@@ -618,8 +618,7 @@ def test_an_ant_foot_before_a_riser_of_the_builtin_stairs_lands_where_it_prefers
     # dilation made the next cell back slope 0.34 rad: the foot landed a cell short (-2.08; in the crowd, also
     # on the riser's dilated top, 7 cm up in the air beside it), and the ant's strides across every riser
     # were 40-75 % off the law.
-    from footfall.planner import FootQuery, WorldRaster, plan_foot
-    from footfall.planner._crowd import planner_config_for
+    from footfall.planner import FootQuery, WorldRaster, plan_foot, planner_config_for
 
     scenario = scenarios.load_scenario("stairs")
     ant = scenarios.load_creature("ant")
