@@ -643,6 +643,20 @@ AVOID_RADIUS_MIN = 0.6
 """x crowd radius: the least: the body. A crowd spawned denser than its legs' span (a big crowd in a
 small world) keeps the spacing it was spawned at (:func:`avoid_radius`): ORCA pushes characters that
 start inside each other's disc apart within a frame."""
+YIELD_RADIUS = 0.6
+"""x avoid radius: the disc a character that cannot make way (standing or held, :data:`MOBILE_FRACTION`)
+keeps, for its own velocity, from one that can: with the legs' span as its disc, its body (the walker
+still keeps its whole disc round it and takes the whole effort; :func:`bodies_apart` still refuses any
+step into a body). Kept to its whole disc, a quadruped standing aside for a neighbour crossing its way
+could not move while the neighbour walked 1.5 m round that disc's edge (their lines 1.03 m apart
+against a 1.08 m disc) and on into its way: 1-3.4 s stuck in every seed of the bar set
+(``crates-moving``). Measured 2026-11-27: the crowds issue's bar set (``footfall evaluate --seeds 10
+--seed-base 3000 --characters 6 --frames 300``), stuck 28 counts (20.6 s) -> 5 (2.2 s), per-stride runs
+7 -> 9, every other count 0 -> 0; crowds of 8 / 16 / 64 on ``mixed`` and ``crates`` (seeds 1-3, 600
+frames), stuck 35 / 46 / 260 -> 31 / 37 / 176 s, feet in boxes 0 / 0 / 88 -> 0 / 3 / 45, crossing
+frames 0 / 1 / 0 -> 0 / 1 / 7; 1000 spiders on ``mixed`` (LOD on, 300 frames; in a crowd that dense the discs
+are the bodies, and a waiting spider keeps 0.6 of its own), seeds 0-2 / 3-5: stuck 294 / 300 -> 193 / 163 s,
+crossing frames 56 / 55 -> 43 / 54, feet in boxes 1 / 0 -> 0 / 0, overlaps 0."""
 AVOID_HORIZON = 2.0
 """s: ORCA's time horizon between characters."""
 AVOID_BOX_HORIZON = 1.5
@@ -910,10 +924,12 @@ def _avoid(model: CrowdModel, state: CrowdState, preferred: np.ndarray, to_targe
     # 63 overlapping frames, mixed, seed 1121411189).
     goal = sustained_speed(state)
     mobile = (state.speed >= MOBILE_FRACTION * goal) & ~state.body_held
+    # ... and such a body, for its own velocity, keeps only part of its disc from those walking
+    # (YIELD_RADIUS).
     out = np.empty((n, 2))
     orca_velocities(xz, np.ascontiguousarray(velocity), np.ascontiguousarray(preferred), np.full(n, radius),
                     np.full(n, top), start, index, *orca_boxes, AVOID_HORIZON, AVOID_BOX_HORIZON, model.dt,
-                    np.ascontiguousarray(escaping), mobile, out)
+                    np.ascontiguousarray(escaping), mobile, np.full(n, YIELD_RADIUS * radius), out)
     avoided = np.hypot(*(out - preferred).T) > 1e-9
     return out, avoided, near, (start, index)
 

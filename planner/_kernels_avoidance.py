@@ -214,7 +214,7 @@ def _cone_line(px, py, vx, vy, r, tau, dt, share, ax, ay, out_point, out_dir, k)
 @nb.njit(cache=True, parallel=True)
 def orca_velocities(positions, velocities, preferred, radii, max_speed, neighbour_start, neighbour_index,
                     box_centres, box_half, box_yaws, box_velocities, box_active, box_pad, time_horizon,
-                    box_time_horizon, dt, priority, mobile, out):
+                    box_time_horizon, dt, priority, mobile, yield_radii, out):
     """New velocity (C, 2) of every character: closest to ``preferred`` among those that avoid
     every neighbour for ``time_horizon`` seconds (sharing the effort) and every active box for
     ``box_time_horizon`` seconds (alone), at most ``max_speed``.
@@ -226,7 +226,9 @@ def orca_velocities(positions, velocities, preferred, radii, max_speed, neighbou
     ``priority`` (C,) bool: between a character with priority and one without, the one without
     takes the whole effort of avoiding (between equals, each takes half); ``mobile`` (C,) bool: a
     character that cannot make way (false: a walker standing still, which only walks off along its
-    heading and turns slowly) is avoided by the other with its whole effort, as a box would be.
+    heading and turns slowly) is avoided by the other with its whole effort, as a box would be;
+    ``yield_radii`` (C,) m: the radius such a character keeps, for its own velocity, from one that can
+    make way (its body; the other still keeps its whole disc round it, ``radii``).
     """
     n = positions.shape[0]
     for c in nb.prange(n):
@@ -269,6 +271,9 @@ def orca_velocities(positions, velocities, preferred, radii, max_speed, neighbou
         n_box_lines = k
         for a in range(neighbour_start[c], neighbour_start[c + 1]):
             j = neighbour_index[a]
+            # A character that cannot make way keeps only its body from one that can: kept to its
+            # whole disc, it stood while a walker went round that disc's edge and on into its way.
+            combined = (yield_radii[c] if mobile[j] and not mobile[c] else ra) + radii[j]
             if not mobile[j]:
                 share = 1.0
             elif priority[c] == priority[j]:
@@ -276,7 +281,7 @@ def orca_velocities(positions, velocities, preferred, radii, max_speed, neighbou
             else:
                 share = 0.0 if priority[c] else 1.0
             _cone_line(positions[j, 0] - pax, positions[j, 1] - paz, vax - velocities[j, 0], vaz - velocities[j, 1],
-                       ra + radii[j], time_horizon, dt, share, vax, vaz, points, directions, k)
+                       combined, time_horizon, dt, share, vax, vaz, points, directions, k)
             k += 1
         result = np.empty(2)
         failed = _plane_program(points, directions, k, speed, preferred[c, 0], preferred[c, 1], False, result)

@@ -16,12 +16,15 @@ TAU = 2.0
 NO_BOXES = (np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), np.zeros((0, 2)), np.zeros(0, np.bool_), np.zeros(0))
 
 
-def _step(pos, vel, pref, radii, vmax, boxes=NO_BOXES, tau=TAU, box_tau=1.0, priority=None, mobile=None):
+def _step(pos, vel, pref, radii, vmax, boxes=NO_BOXES, tau=TAU, box_tau=1.0, priority=None, mobile=None,
+          yield_radii=None):
     start, index = neighbour_lists(pos, 10.0)
     out = np.empty_like(pos)
     priority = np.zeros(len(pos), np.bool_) if priority is None else priority
     mobile = np.ones(len(pos), np.bool_) if mobile is None else mobile
-    orca_velocities(pos, vel, pref, radii, vmax, start, index, *boxes, tau, box_tau, DT, priority, mobile, out)
+    yield_radii = radii if yield_radii is None else yield_radii
+    orca_velocities(pos, vel, pref, radii, vmax, start, index, *boxes, tau, box_tau, DT, priority, mobile, yield_radii,
+                    out)
     return out
 
 
@@ -112,6 +115,25 @@ def test_a_character_steers_round_one_that_cannot_make_way_with_its_whole_effort
     out = _step(*args, mobile=np.array([True, False]))
     assert out[0] == pytest.approx([3.0 / 4.0, -math.sqrt(3.0) / 4.0], abs=1e-12)
     assert out[1] == pytest.approx([1.0 / 8.0, math.sqrt(3.0) / 8.0], abs=1e-12)
+
+
+def test_one_that_cannot_make_way_keeps_only_its_body_from_one_that_can():
+    """The case above, B's body 0.3 (its disc 0.5): for B's own velocity the pair's radius is 0.3 + 0.5 =
+    0.8. By the same construction, w = 0 and the leg |p|^2 - r^2 = 3.36 away: B's change is
+    u = (r^2 / 4, r sqrt(3.36) / 4), all of it B's (A has priority). A still keeps the whole disc round B."""
+    pos = np.array([[0.0, 0.0], [2.0, 0.0]])
+    vel = np.array([[1.0, 0.0], [0.0, 0.0]])
+    args = (pos, vel, vel.copy(), np.array([0.5, 0.5]), np.array([2.0, 2.0]))
+    out = _step(*args, priority=np.array([True, False]), mobile=np.array([True, False]),
+                yield_radii=np.array([0.3, 0.3]))
+    assert out[0] == pytest.approx([3.0 / 4.0, -math.sqrt(3.0) / 4.0], abs=1e-12)
+    assert out[1] == pytest.approx([0.16, 0.2 * math.sqrt(3.36)], abs=1e-12)
+    # Two that cannot make way, or two that can, keep their whole discs from each other.
+    for mobile in ([False, False], [True, True]):
+        both = _step(*args, priority=np.array([True, False]), mobile=np.array(mobile),
+                     yield_radii=np.array([0.3, 0.3]))
+        plain = _step(*args, priority=np.array([True, False]), mobile=np.array(mobile))
+        np.testing.assert_array_equal(both, plain)
 
 
 def test_a_free_character_keeps_its_preferred_velocity_capped_at_its_top_speed():
