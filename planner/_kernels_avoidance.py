@@ -228,7 +228,8 @@ def orca_velocities(positions, velocities, preferred, radii, max_speed, neighbou
     character that cannot make way (false: a walker standing still, which only walks off along its
     heading and turns slowly) is avoided by the other with its whole effort, as a box would be;
     ``yield_radii`` (C,) m: the radius such a character keeps, for its own velocity, from one that can
-    make way (its body; the other still keeps its whole disc round it, ``radii``).
+    make way (less than its disc, ``planner._crowd.YIELD_RADIUS``; the other still keeps the whole disc
+    round it, ``radii``).
     """
     n = positions.shape[0]
     for c in nb.prange(n):
@@ -271,8 +272,8 @@ def orca_velocities(positions, velocities, preferred, radii, max_speed, neighbou
         n_box_lines = k
         for a in range(neighbour_start[c], neighbour_start[c + 1]):
             j = neighbour_index[a]
-            # A character that cannot make way keeps only its body from one that can: kept to its
-            # whole disc, it stood while a walker went round that disc's edge and on into its way.
+            # A character that cannot make way keeps only part of its disc from one that can: kept to
+            # its whole disc, it stood while a walker went round that disc's edge and on into its way.
             combined = (yield_radii[c] if mobile[j] and not mobile[c] else ra) + radii[j]
             if not mobile[j]:
                 share = 1.0
