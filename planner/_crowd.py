@@ -656,7 +656,10 @@ against a 1.08 m disc) and on into its way: 1-3.4 s stuck in every seed of the b
 frames), stuck 35 / 46 / 260 -> 31 / 37 / 176 s, feet in boxes 0 / 0 / 88 -> 0 / 3 / 45, crossing
 frames 0 / 1 / 0 -> 0 / 1 / 7; 1000 spiders on ``mixed`` (LOD on, 300 frames; in a crowd that dense the discs
 are the bodies, and a waiting spider keeps 0.6 of its own), seeds 0-2 / 3-5: stuck 294 / 300 -> 193 / 163 s,
-crossing frames 56 / 55 -> 43 / 54, feet in boxes 1 / 0 -> 0 / 0, overlaps 0."""
+crossing frames 56 / 55 -> 43 / 54, feet in boxes 1 / 0 -> 0 / 0, overlaps 0. At 0.7: the bar set's stuck
+4 counts, per-stride runs 5 (seeds 4000-4009: 12 and 7, against 11 and 10 at 0.6), but 1000 spiders,
+seeds 0-2: 56 feet in boxes and 207 crossing frames (3-5: 5 and 36), and 16 characters of the crowd bar
+12 feet in boxes; at 0.5: stuck 3, per-stride 11."""
 AVOID_HORIZON = 2.0
 """s: ORCA's time horizon between characters."""
 AVOID_BOX_HORIZON = 1.5
