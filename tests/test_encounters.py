@@ -348,6 +348,37 @@ def test_a_character_in_a_crates_lane_heads_for_its_top_speed_and_beside_it_for_
         assert state.goal_speed[0] == pytest.approx(goal, abs=1e-12)
 
 
+def test_an_escaper_nothing_hinders_walks_at_its_flee_speed(tmp_path, monkeypatch):
+    # The crate and spider above, the spider in the lane and already facing the way out that the steering
+    # chose, with ORCA changing nothing (its velocity the preferred one). It walks toward its flee speed
+    # (0.54 m/s) as far as FLEE_GAIN_MAX of the asked 0.3 m/s: 0.375 m/s, not the asked 0.3 (an ant
+    # crossing a crate's lane unhindered at 0.3 m/s had a foot caught: mixed, 16 ants, seed 3).
+    from footfall.planner import _crowd as crowd
+
+    model, state = _world(tmp_path, "unhindered", crate_centre=(1.0, 0.0), crate_width=0.5, start=(0.0, 0.0),
+                          goal=(4.0, 0.0), velocity=(-0.2, 0.0))
+
+    def no_one_in_the_way(model, state, preferred, *args):
+        n = preferred.shape[0]
+        return preferred.copy(), np.zeros(n, np.bool_), np.zeros(n, np.bool_), (np.zeros(n + 1, np.int64),
+                                                                              np.zeros(0, np.int64))
+
+    monkeypatch.setattr(crowd, "_avoid", no_one_in_the_way)
+    pelvis, speed = state.pelvis.copy(), state.speed.copy()
+    heading = float(state.heading[0])
+    for _ in range(100):  # the same moment again, turned toward the way out until it faces it
+        state.pelvis[:], state.speed[:], state.heading[0] = pelvis, speed, heading
+        crowd.stage_steer(model, state, crowd._boxes_now(model, state.t))
+        if abs(state.turn_wanted[0]) < 1e-9:
+            break
+        heading += float(state.turn_wanted[0])
+    assert abs(state.turn_wanted[0]) < 1e-9
+    assert state.escaping[0]
+    assert state.goal_speed[0] == pytest.approx(crowd.FLEE_SPEED * model.top_speed, abs=1e-12)
+    assert crowd.FLEE_SPEED * model.top_speed > crowd.FLEE_GAIN_MAX * 0.3  # premise: the gain holds it
+    assert state.speed_wanted[0] == pytest.approx(crowd.FLEE_GAIN_MAX * 0.3, abs=1e-12)
+
+
 def test_between_two_crates_lanes_the_way_out_leads_away_from_both(tmp_path, monkeypatch):
     # Two 0.5 m crates drive -x at 0.2 m/s: A head-on at (1, 0), B passing beside the spider at (0, 0.6).
     # The spider stands at (0, 0.05), its way +x. A's nearer side is +z, B's is -z: summed, the two exits
