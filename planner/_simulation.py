@@ -65,6 +65,9 @@ class SimulationSummary:
         asked speed over the last 2 s.
     max_pelvis_jump_m : float
         m: the largest change of a pelvis's height from one frame to the next.
+    box_shoves : int
+        Character-frames in which a moving box reached a foot in the air and shoved the body out of its
+        way (its escape failed; :func:`planner._crowd.shove_out_of_moving_boxes`).
     ms_per_frame_median, ms_per_frame_mean : float
         Frame times, ms (the mean includes the first frame).
     ms_per_frame_warmup, ms_per_frame_steady : float or None
@@ -135,6 +138,7 @@ class SimulationSummary:
     stuck_seconds: float = 0.0
     unavoidable_contacts: int = 0
     max_pelvis_jump_m: float = 0.0
+    box_shoves: int = 0
     ms_per_frame_warmup: float | None = None
     """The first frame's ms: a fresh process loads (or, on a cold cache, compiles) the numba kernels
     there, so it can be 100x a steady frame; ``ms_per_frame_mean`` includes it."""
@@ -589,7 +593,7 @@ def simulate(model: CrowdModel, state: CrowdState, frames: int, recorder: Record
         speed_reached=reached, duty_factor_mean=stance_feet / walking_feet if walking_feet else None,
         body_overlaps=counters.body_overlaps, shared_foot_spots=counters.shared_foot_spots,
         stuck_seconds=counters.stuck_seconds, unavoidable_contacts=counters.unavoidable_contacts,
-        max_pelvis_jump_m=counters.max_pelvis_jump_m,
+        max_pelvis_jump_m=counters.max_pelvis_jump_m, box_shoves=int(c["shoves"]),
         ms_per_frame_warmup=float(frame_ms[0]) if frames else None,
         ms_per_frame_steady=float(np.mean(frame_ms[1:])) if frames > 1 else None,
         lod_levels=levels.summary(*strides.by_level()) if levels is not None else None,

@@ -192,7 +192,7 @@ def write_outputs(out: Path, result: dict, pictures: dict[str, bytes]) -> None:
     buf = io.StringIO()
     writer = csv.writer(buf)
     measured = ("max_stance_slip_m", "ik_residual_p95_m", "stride_rel_error_median", "stride_rel_error_p90",
-                "speed_asked", "speed_reached", "stuck_seconds", "max_pelvis_jump_m")
+                "speed_asked", "speed_reached", "stuck_seconds", "max_pelvis_jump_m", "box_shoves")
     writer.writerow(["scenario", "creature", "seed", "characters", "frames", "lod", *PROMISE_NAMES, *measured])
     for run in result["_runs"]:
         writer.writerow([run["scenario"], run["creature"], run["seed"], run["characters"], run["frames"], run["lod"],

@@ -805,3 +805,44 @@ def test_no_character_is_spawned_where_a_crate_will_be_within_the_spawn_horizon(
         # The crate moves 5 cm between the 0.1 s samples: up to half that nearer in between.
         assert gap > 0.5 * math.hypot(0.3, 0.3) + crowd_radius(creature) + 0.1 - 0.05 * 0.5
         assert not np.any(np.all(spawned == [-2.0, 0.0], axis=1))
+
+
+def test_a_moving_box_that_reaches_a_foot_in_the_air_shoves_the_body_and_its_feet_in_the_air():
+    # One spider at the origin, leg 0 in the air at (0.15, 0.05); a 0.2 m crate (moving, yaw 0) whose -x
+    # face is 5 mm beyond that foot. The crate's nearest point to the pelvis is on that face, so the body
+    # goes straight -x, by the foot's half diagonal and the margin less the 5 mm; the foot in the air
+    # (and its swing) goes with it, the stance feet stay. A crate 1 cm further than that shoves nothing.
+    from footfall.planner import _crowd as crowd
+
+    spider = load_creature("spider")
+    model, state = init_crowd(load_scenario("flat"), spider, gait_schedule(spider), n_characters=1, seed=0)
+    state.pelvis[0, [0, 2]] = 0.0
+    state.in_stance[0] = True
+    state.in_stance[0, 0] = False
+    state.feet[0, 0, [0, 2]] = [0.15, 0.05]
+    state.trajectories[0, 0, :, 0], state.trajectories[0, 0, :, 2] = 0.15, 0.05
+    state.swing_target[0, 0, [0, 2]] = [0.15, 0.05]
+    need = 0.5 * math.hypot(spider.foot_length, spider.foot_width) + crowd.SHOVE_MARGIN
+
+    def crate(gap):
+        return (np.array([[0.15 + gap + 0.1, 0.1, 0.05]]), np.array([[0.2, 0.2, 0.2]]), np.zeros(1),
+                np.ones(1, np.bool_), np.ones(1, np.bool_))
+
+    before = (state.pelvis.copy(), state.feet.copy(), state.trajectories.copy(), state.swing_target.copy())
+    crowd.shove_out_of_moving_boxes(model, state, crate(need + 0.01))
+    assert state.counters["shoves"] == 0
+    np.testing.assert_array_equal(state.pelvis, before[0])
+    np.testing.assert_array_equal(state.feet, before[1])
+
+    crowd.shove_out_of_moving_boxes(model, state, crate(0.005))
+    push = np.array([-(need - 0.005), 0.0])
+    assert state.counters["shoves"] == 1
+    np.testing.assert_allclose(state.pelvis[0, [0, 2]], before[0][0, [0, 2]] + push, atol=1e-12)
+    assert state.pelvis[0, 1] == before[0][0, 1]
+    np.testing.assert_allclose(state.feet[0, 0, [0, 2]], [0.15 + push[0], 0.05], atol=1e-12)
+    np.testing.assert_allclose(state.trajectories[0, 0][:, [0, 2]], [[0.15 + push[0], 0.05]] * state.trajectories.shape[2],
+                               atol=1e-12)
+    np.testing.assert_allclose(state.swing_target[0, 0, [0, 2]], [0.15 + push[0], 0.05], atol=1e-12)
+    np.testing.assert_array_equal(state.feet[0, 1:], before[1][0, 1:])  # the stance feet stay
+    # The foot in the air now keeps exactly the margin from the crate's face.
+    assert (0.15 + 0.005) - (0.15 + push[0]) == pytest.approx(need, abs=1e-12)
