@@ -371,6 +371,7 @@ class CrowdState:
     in_stance: np.ndarray  # (C, L) bool
     wants_swing: np.ndarray  # (C, L) bool: the gait asked for a swing not yet planned
     sector_missed: np.ndarray  # (C, L) bool: the needle entered the foot's sector while it was in the air
+    stalled_s: np.ndarray  # (C,) s the body's legs (not a hold) have kept it at rest while it asks to walk
     swing_t: np.ndarray
     swing_T: np.ndarray
     trajectories: np.ndarray  # (C, L, K, 3)
@@ -1184,6 +1185,15 @@ def stage_gait(model: CrowdModel, state: CrowdState):
     window = float(np.min(model.stance_window[:, 1] - model.stance_window[:, 0]))
     frequency = set_speed(state.gaits, model.timing, state.speed, model.leg_height,
                           duty_ceiling(max(window, 1e-9), stride))
+    # A body its legs have kept at rest for STALL_S (a foot at the rear end of its window whose step found
+    # no footprint: the stance cap, not a hold) keeps the needle turning at the tempo it will resume:
+    # stopped with the body, the other legs never lifted, and the one in the way of the stopped foot's
+    # step never moved (STALL_S).
+    stalled = (state.speed <= 0.0) & (state.speed_wanted > 0.0) & ~state.body_held
+    state.stalled_s = np.where(stalled, state.stalled_s + model.dt, 0.0)
+    stalled &= state.stalled_s >= STALL_S
+    if stalled.any():
+        frequency = np.where(stalled, np.maximum(frequency, resume_frequency(model, state)), frequency)
     state.stride_frequency = frequency
     in_air = ~state.in_stance
     enter, fraction = advance(state.gaits, frequency, model.dt, state.in_stance)
@@ -1196,6 +1206,19 @@ def stage_gait(model: CrowdModel, state: CrowdState):
     state.sector_missed |= in_air & ((phase < sweep) | (sweep >= 1.0))
     state.sector_missed &= phase < g.disk_duration  # the turn lapses with its sector
     return frequency, enter, fraction
+
+
+STALL_S = 1.0
+"""s a body its legs keep at rest while it asks to walk before its needle turns on without it, at the tempo
+it will resume (:func:`stage_gait`). The needle's tempo follows the body's speed, so a body its stance cap
+held at 0 m/s stopped its own gait: a spider on ``mixed`` (seed 4006, character 3) stood 6.8 s, its rear
+leg 6 past its window's rear end, every cell of the forced step's search disc beyond leg 5's line (leg 5's
+foot 3 cm from its preferred footprint), and leg 5 never lifted. Measured 2026-11-27 (README, crowds and
+moving boxes): the crowds issue's bar sets, stuck counts 5 / 11 -> 4 / 4 (seeds 3000-3009 / 4000-4009;
+the ``crates`` spider's walled-in foot of seed 3009 1.4 -> 0.07 s), per-stride runs and crossing frames
+the same; 1000 spiders on ``mixed`` (seeds 0-2 / 3-5), crossing frames 38 / 49 -> 39 / 57, stuck
+173 / 159 -> 168 / 154 s. With no wait (0 s), those 1000 spiders had 109 crossing frames on seeds 0-2: a
+dense crowd's bodies stop for a moment often."""
 
 
 def stage_swing(model: CrowdModel, state: CrowdState, boxes) -> np.ndarray:
@@ -2386,7 +2409,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         t=0.0, frame=0, pelvis=pelvis, heading=headings.copy(), pitch=np.zeros(n), roll=np.zeros(n),
         speed=np.zeros(n), desired_speed=np.full(n, speed), route=routes, route_index=np.zeros(n, np.int64),
         feedback=np.zeros((n, 2)), feet=feet, in_stance=np.ones((n, L), np.bool_),
-        wants_swing=np.zeros((n, L), np.bool_), sector_missed=np.zeros((n, L), np.bool_), swing_t=np.zeros((n, L)), swing_T=np.zeros((n, L)),
+        wants_swing=np.zeros((n, L), np.bool_), sector_missed=np.zeros((n, L), np.bool_), stalled_s=np.zeros(n), swing_t=np.zeros((n, L)), swing_T=np.zeros((n, L)),
         trajectories=np.repeat(feet[:, :, None, :], K, axis=2), swing_target=feet.copy(),
         plan_heading=np.repeat(headings[:, None], L, axis=1), plan_speed=np.zeros((n, L)),
         feet_spacing=np.ones(n), plan_spacing=np.ones((n, L)), foot_yaws=yaws,

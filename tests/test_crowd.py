@@ -758,3 +758,32 @@ def test_a_spawned_foot_never_stands_on_a_forbidden_box(tmp_path):
     assert placed[right, 1] == pytest.approx(0.04)
     others = [k for k in range(feet.shape[0]) if k not in (left, right)]
     assert np.array_equal(placed[others, 1], np.zeros(len(others)))
+
+
+def test_a_body_its_legs_keep_at_rest_for_STALL_S_keeps_its_needle_turning():
+    # A spider asked to walk (speed_wanted 0.3) whose legs hold it at 0 m/s (not a hold): for STALL_S its
+    # needle stands with the body (the tempo of a body at rest is 0); after that it turns at the tempo of
+    # the walk the body will resume, so the leg in the way of the stopped foot's step can lift. A hold
+    # resets the count.
+    from footfall.planner import _crowd as crowd
+    from footfall.scenarios import default_gait, load_creature, load_scenario
+
+    spider = load_creature("spider")
+    model, state = init_crowd(load_scenario("flat"), spider, default_gait(spider), n_characters=1, seed=0)
+    state.speed[0], state.speed_wanted[0], state.body_held[0] = 0.0, 0.3, False
+    frames = int(math.ceil(crowd.STALL_S / model.dt - 1e-9))
+    state.stalled_s[0] = (frames - 2) * model.dt
+    needle = float(state.gaits.needle[0])
+    crowd.stage_gait(model, state)
+    assert state.stalled_s[0] == pytest.approx((frames - 1) * model.dt, abs=1e-12)
+    assert float(state.gaits.needle[0]) == needle  # premise: at rest the needle stands
+    crowd.stage_gait(model, state)
+    assert state.stalled_s[0] >= crowd.STALL_S
+    tempo = float(crowd.resume_frequency(model, state)[0])
+    assert tempo > 0.0
+    assert float(state.gaits.needle[0]) == pytest.approx((needle + tempo * model.dt) % 1.0, abs=1e-12)
+    state.body_held[0] = True
+    needle = float(state.gaits.needle[0])
+    crowd.stage_gait(model, state)
+    assert state.stalled_s[0] == 0.0
+    assert float(state.gaits.needle[0]) == needle
