@@ -89,6 +89,9 @@ def test_strict_fails_on_a_violation_and_a_plain_run_reports_it(monkeypatch, tmp
     assert "footfall simulate flat --creature spider --seed 0 --characters 2 --frames 30 --lod off" in plain.stdout
     for name in ("index.html", "evaluate.json", "runs.csv", "worst-0.png"):
         assert (tmp_path / "ev" / name).stat().st_size > 0, name
+    header = (tmp_path / "ev" / "runs.csv").read_text().splitlines()[0].split(",")
+    assert len(header) == len(set(header)), header  # a reader by column name gets every column
+    assert {"speed_reached", "speed_reached_m_s", "box_shoves", "stuck_seconds"} <= set(header)
     assert _invoke(*SMALL, "--seed-base", "0", "--strict").exit_code == 1
 
 
