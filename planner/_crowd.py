@@ -1428,6 +1428,12 @@ def _stance_unreachable_ahead(model: CrowdModel, state: CrowdState, hips, freque
     return out.copy()
 
 
+STEP_FOR_ASKED = 0.5
+"""x the goal speed: the least asked speed a stance foot must carry the body at half of, or step out of
+turn (stage_requests). With no floor (half of whatever the steering asks), the bar set's stuck runs
+went 4 -> 10: a body asked to crawl let its feet run to the rear of their windows."""
+
+
 def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, frequency) -> np.ndarray:
     """(C, L) int8 request kinds: 0 none, 1 new swing, 2 forced step, 3 re-plan."""
     ctl = model.controller
@@ -1455,13 +1461,18 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, fre
     # A stance foot at the rear end of its window steps now: the body cannot move on without it
     # (stance_speed_cap holds the body back), and its sector may be a cycle away.
     # A stance foot that holds the body under half its goal speed (stance_speed_cap) steps now too:
-    # waiting for its sector, with the body slow and the needle slower, would freeze the walk.
+    # waiting for its sector, with the body slow and the needle slower, would freeze the walk. Half
+    # the speed the steering asks, where a turn or a neighbour asks less (STEP_FOR_ASKED, never
+    # under half the goal's half): held to half the goal, a `crates` spider turning at its full rate
+    # (asked 30-40 % of the goal) lifted one foot in six out of turn, and each landed mid-cycle, so
+    # the stride after it was half a stride (the bar set's per-stride runs).
     # A body at its goal (the steering's goal speed 0) does not move on: its feet need no room. Asked
     # for the walk's speed there, a spider at rest stepped one foot back and forth for good between a
     # spot past the rear of its window and one that capped the speed it was not going to walk.
     goal = state.goal_speed[:, None]
     room, lift = stance_room(model, state), until_lift(model, state)
-    far |= cannot_follow | ((room <= 0.0) & (goal > 0.0)) | (leg_speed_caps(model, state, room, lift) < 0.5 * goal)
+    asked = np.maximum(np.minimum(state.goal_speed, state.speed_wanted), STEP_FOR_ASKED * state.goal_speed)[:, None]
+    far |= cannot_follow | ((room <= 0.0) & (goal > 0.0)) | (leg_speed_caps(model, state, room, lift) < 0.5 * asked)
     # So does a stance foot that stops the body's turn (stance_turn_bounds: no room left), or holds the
     # turn of a slow body under half the turn asked: a body turning on the spot turns by stepping.
     bound, wanted = leg_turn_bounds(model, state, lift), state.turn_wanted[:, None]

@@ -413,20 +413,22 @@ def test_a_crowd_spawns_with_every_foot_a_foots_room_from_the_other_characters_f
 def test_a_crowds_feet_keep_a_foots_room_from_each_other():
     """16 spiders on ``crates``: no two stance feet of different characters closer than a foot length
     (``shared_foot_spots``), because every planned foot keeps a foot's room from the other characters'
-    feet near it (where they stand, or will land). Without that, the same run shares spots (seed 7: 6
+    feet near it (where they stand, or will land). Without that, the same runs share spots (seed 7: 6
     pair-frames; seed 5 did until characters standing still were avoided with the whole effort, and
-    then its crowd never brought two feet together)."""
+    then its crowd never brought two feet together; seed 7 stopped once feet stepped out of turn for
+    half the asked speed, STEP_FOR_ASKED, and seed 4 then shared 23 pair-frames). Both seeds kept."""
     import dataclasses
 
     scenario, creature = load_scenario("crates"), load_creature("spider")
-    counts = {}
-    for avoid in (True, False):
-        model, state = init_crowd(scenario, creature, load_gait(default_gait_name("spider"), creature),
-                                  n_characters=16, seed=7, lod_mode="off", raster=_raster(scenario, creature))
-        model = dataclasses.replace(model, controller=dataclasses.replace(model.controller, avoid_others_feet=avoid))
-        counts[avoid] = simulate(model, state, 200).shared_foot_spots
+    counts = {True: 0, False: 0}
+    for seed in (4, 7):
+        for avoid in (True, False):
+            model, state = init_crowd(scenario, creature, load_gait(default_gait_name("spider"), creature),
+                                      n_characters=16, seed=seed, lod_mode="off", raster=_raster(scenario, creature))
+            model = dataclasses.replace(model, controller=dataclasses.replace(model.controller, avoid_others_feet=avoid))
+            counts[avoid] += simulate(model, state, 200).shared_foot_spots
     assert counts[True] == 0
-    assert counts[False] > 0, "the run must bring feet of different characters together"
+    assert counts[False] > 0, "the runs must bring feet of different characters together"
 
 
 def test_two_feet_planned_in_one_frame_never_share_a_spot_whether_of_one_character_or_two():
@@ -787,3 +789,31 @@ def test_a_body_its_legs_keep_at_rest_for_STALL_S_keeps_its_needle_turning():
     crowd.stage_gait(model, state)
     assert state.stalled_s[0] == 0.0
     assert float(state.gaits.needle[0]) == needle
+
+
+def test_a_stance_foot_steps_out_of_turn_only_when_it_holds_the_body_under_half_the_asked_speed():
+    """A stance foot whose leg cannot carry the body at half the speed asked steps now (a forced step);
+    'asked' is what the steering asks (a turn or a neighbour may ask less than the goal), never taken
+    under STEP_FOR_ASKED of the goal: a body asked to crawl still moves its feet on."""
+    from footfall.planner._crowd import STEP_FOR_ASKED, leg_speed_caps, stage_requests
+
+    model, state, args = _standing_on_flat("spider")
+    snapshot = {k: getattr(state, k).copy() for k in ("cannot_follow", "unfollowed", "body_held", "speed_limit")}
+
+    def forced(goal, wanted):
+        for k, v in snapshot.items():
+            setattr(state, k, v.copy())
+        state.goal_speed[0], state.speed_wanted[0] = goal, wanted
+        return np.flatnonzero(stage_requests(model, state, *args)[0] == 2)
+
+    caps = leg_speed_caps(model, state)[0]
+    j = int(np.argmin(np.where(np.isfinite(caps) & (caps > 0.0), caps, np.inf)))
+    cap = float(caps[j])
+    assert 0.0 < cap < np.inf
+    # The goal's half is above the cap: asked the goal, the foot steps...
+    assert forced(3.0 * cap, 3.0 * cap).tolist() == [j]
+    # ... asked a third of it (a turn), half the asked speed (0.75 cap) is within the cap: no step.
+    assert forced(3.0 * cap, 1.0 * cap).size == 0
+    # Asked nothing, the floor counts: half of STEP_FOR_ASKED x goal, above the cap, so it steps.
+    goal = 1.01 * cap / (0.5 * STEP_FOR_ASKED)
+    assert forced(goal, 0.0).tolist() == [j]
