@@ -1430,8 +1430,8 @@ def _stance_unreachable_ahead(model: CrowdModel, state: CrowdState, hips, freque
 
 STEP_FOR_ASKED = 0.5
 """x the goal speed: the least asked speed a stance foot must carry the body at half of, or step out of
-turn (stage_requests). With no floor (half of whatever the steering asks), the bar set's stuck runs
-went 4 -> 10: a body asked to crawl let its feet run to the rear of their windows."""
+turn (stage_requests). With no floor (half of whatever the steering asks), the bar set's stuck count
+went 4 -> 10 (seeds 3000-3009)."""
 
 
 def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, frequency) -> np.ndarray:
