@@ -1464,8 +1464,8 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, fre
     # waiting for its sector, with the body slow and the needle slower, would freeze the walk. Half
     # the speed the steering asks, where a turn or a neighbour asks less (STEP_FOR_ASKED, never
     # under half the goal's half): held to half the goal, a `crates` spider turning at its full rate
-    # (asked 30-40 % of the goal) lifted one foot in six out of turn, and each landed mid-cycle, so
-    # the stride after it was half a stride (the bar set's per-stride runs).
+    # (walking at 0.38 of its goal, median) lifted one foot in six out of turn; such a foot lands
+    # mid-cycle, and the stride after it was half a stride (the bar set's per-stride runs).
     # A body at its goal (the steering's goal speed 0) does not move on: its feet need no room. Asked
     # for the walk's speed there, a spider at rest stepped one foot back and forth for good between a
     # spot past the rear of its window and one that capped the speed it was not going to walk.
