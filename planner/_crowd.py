@@ -647,20 +647,19 @@ SHOVE_ROUNDS = 3
 normal can leave a foot near a corner short of the margin)."""
 
 
-def _rect_gaps(points, centre, half, cos, sin):
-    """(P,) signed gap of ``points`` (P, 2) to a box's rectangle (negative inside) and (P, 2) the unit
-    direction from its nearest point out to each (out of the nearer face, inside)."""
-    rel = points - centre
-    along, across = rel[:, 0] * cos + rel[:, 1] * sin, -rel[:, 0] * sin + rel[:, 1] * cos
-    inside = (np.abs(along) < half[0]) & (np.abs(across) < half[1])
-    da, dc = along - np.clip(along, -half[0], half[0]), across - np.clip(across, -half[1], half[1])
-    by_along = (half[0] - np.abs(along)) <= (half[1] - np.abs(across))
-    da = np.where(inside & by_along, np.sign(along + 1e-300) * (half[0] - np.abs(along)), da)
-    dc = np.where(inside & ~by_along, np.sign(across + 1e-300) * (half[1] - np.abs(across)), dc)
-    norm = np.hypot(da, dc)
-    gap = np.where(inside, -norm, norm)
-    ua, uc = np.where(norm > 1e-12, da / np.maximum(norm, 1e-300), 1.0), np.where(norm > 1e-12, dc / np.maximum(norm, 1e-300), 0.0)
-    return gap, np.column_stack([ua * cos - uc * sin, ua * sin + uc * cos])
+def _box_gap_out(x, z, centre, half, yaw):
+    """(signed gap of (x, z) to a box's rectangle, negative inside; (2,) unit direction from the box's
+    nearest point (:func:`planner._kernels_avoidance._nearest_on_box`, ORCA's) out to it, or out of the
+    nearer face from inside)."""
+    from footfall.planner._kernels_avoidance import _nearest_on_box
+
+    qx, qz, inside = _nearest_on_box(x, z, centre[0], centre[1], half[0], half[1], yaw)
+    dx, dz = x - qx, z - qz
+    norm = math.hypot(dx, dz)
+    if norm <= 1e-12:  # on the boundary: out along the box's own x
+        return 0.0, np.array([math.cos(yaw), math.sin(yaw)])
+    sign = -1.0 if inside else 1.0
+    return sign * norm, np.array([sign * dx / norm, sign * dz / norm])
 
 
 def shove_out_of_moving_boxes(model: CrowdModel, state: CrowdState, boxes) -> None:
@@ -693,15 +692,13 @@ def shove_out_of_moving_boxes(model: CrowdModel, state: CrowdState, boxes) -> No
         air = np.flatnonzero(~state.in_stance[c])
         if not air.size:
             continue
-        cos, sin = math.cos(yaws[b]), math.sin(yaws[b])
-        centre = centres[b, [0, 2]]
+        yaw, centre = float(yaws[b]), centres[b, [0, 2]]
         for _ in range(SHOVE_ROUNDS):
-            gap, _ = _rect_gaps(state.feet[c, air][:, [0, 2]], centre, half[k], cos, sin)
-            short = need - gap.min()
+            gap = min(_box_gap_out(state.feet[c, j, 0], state.feet[c, j, 2], centre, half[k], yaw)[0] for j in air)
+            short = need - gap
             if short <= 0.0:
                 break
-            _, out = _rect_gaps(state.pelvis[c, [0, 2]][None], centre, half[k], cos, sin)
-            push = short * out[0]
+            push = short * _box_gap_out(state.pelvis[c, 0], state.pelvis[c, 2], centre, half[k], yaw)[1]
             state.pelvis[c, [0, 2]] += push
             for d, p in ((0, push[0]), (2, push[1])):
                 state.feet[c, air, d] += p
