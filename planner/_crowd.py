@@ -66,6 +66,7 @@ from footfall.planner._maps import WorldRaster
 from footfall.planner._params import PlannerConfig, SearchBudget
 from footfall.planner._timing import stance_lead
 from footfall.planner._weights import ScoringWeights
+from footfall.planner.layout import CNT_BOXED, CNT_COUPLES_3D, CNT_EXPANDED
 
 DT = 1.0 / 30.0
 ESCAPE_FROUDE = 0.5
@@ -1793,8 +1794,9 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     state.counters["plans"] += int(f)
     state.counters["holds"] += int((~out.valid & new).sum())
     state.counters["replans"] += int((kinds[cs, ls] == 3).sum())
-    state.counters["cells_expanded"] += int(out.counters[:, 2].sum())
-    state.counters["couples_evaluated"] += int(out.counters[:, 0].sum())
+    state.counters["cells_expanded"] += int(out.counters[:, CNT_EXPANDED].sum())
+    state.counters["couples_evaluated"] += int(out.counters[:, CNT_COUPLES_3D].sum())
+    state.counters["boxed_ways"] += int(out.counters[new, CNT_BOXED].sum())
     return batch, out, cs, ls, calls
 
 
@@ -2427,7 +2429,8 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         threatened=np.zeros((n, L), np.bool_), tucked=np.zeros((n, L), np.bool_),
         escaping=np.zeros(n, np.bool_), goal_speed=np.full(n, speed), speed_wanted=np.zeros(n), blocks_escape=np.zeros((n, L), np.bool_), crossed=np.zeros((n, L, L), np.bool_),
         counters={k: 0 for k in ("steps", "plans", "holds", "replans", "forbidden_footprints", "cells_expanded",
-                                 "couples_evaluated", "pose_takebacks", "crossing_takebacks", "map_cells_built", "ik_ccd_legs", "ik_two_bone_legs", "shoves")},
+                                 "couples_evaluated", "pose_takebacks", "crossing_takebacks", "map_cells_built", "ik_ccd_legs", "ik_two_bone_legs", "shoves",
+                                 "boxed_ways")},
         lod_level=np.full(n, LEVEL_FULL, np.int8), near_moving_box=np.zeros(n, np.bool_),
         aim_node=np.full(n, -1, np.int64))
     stage_pelvis(model, state, smoothing=1.0)  # the first pose is the hull's own

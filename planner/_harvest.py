@@ -33,7 +33,7 @@ from footfall.planner._params import DEFAULT_BUDGET, PlannerConfig, SearchBudget
 from footfall.planner._search import FootQuery, checked_foot_offsets
 from footfall.planner._threads import single_threaded
 from footfall.planner._weights import N_FOOTPRINT_TERMS, N_TERMS, ScoringWeights
-from footfall.planner.layout import FEATURES, N_FEATURES, N_RAW  # FEATURES: the order of ``cand_features``
+from footfall.planner.layout import CNT_BOXED, FEATURES, N_FEATURES, N_RAW  # FEATURES: the order of ``cand_features``
 
 
 
@@ -166,7 +166,9 @@ class Harvest:
     (tuning/_proxies.py moves the preferred footprint with the timing parameters),
     the candidate set, and the exhaustive search's pick (``chosen``: (k, s) or
     (-1, -1) when no couple exists) with its scores, goodnesses and raw metrics.
-    ``crowd_choice`` is the couple the crowd's own (budgeted) search took.
+    ``crowd_choice`` is the couple the crowd's own (budgeted) search took. A boxed-in
+    foot's way out (``planner.layout.CNT_BOXED``) is no harvested couple: it counts
+    as no pick in both.
 
     Made by :func:`pack_harvest`; the per-candidate and per-couple arrays are those of each
     situation's :class:`FootHarvest`, padded (``cand_mask`` and ``couple_mask`` say which
@@ -281,12 +283,12 @@ def _harvest_batch(batch, weights, config, out, cs, ls, kinds, state, model, met
         slice_size = float(batch.slice_size[i])
         foot = _harvest_kernel_call(*args, slice_size)
         # The exhaustive search (no couple limit, no early stop) on the same foot and slices.
-        best = plan_foot_kernel(*args, -1, slice_size, False, MODE_SEARCH)
+        best = plan_foot_kernel(*args, -1, slice_size, False, MODE_SEARCH, batch.foot_shape[i])
         chosen = (-1, -1)
-        if best.valid:
+        if best.valid and not best.counters[CNT_BOXED]:
             chosen = _row_of(foot.cand_cells, foot.levels.size, best.target_rc, int(best.slice_index))
         crowd = (-1, -1)
-        if out.valid[i]:
+        if out.valid[i] and not out.counters[i, CNT_BOXED]:
             # The target is a candidate's continuous footprint, computed by the same kernel: equal bit for bit.
             hit = np.flatnonzero((foot.cand_xyz[:, 0] == out.target[i, 0]) & (foot.cand_xyz[:, 2] == out.target[i, 2]))
             if hit.size != 1:

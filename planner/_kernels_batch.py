@@ -37,7 +37,7 @@ def plan_one_into(i, req, w, cfg, mode, out):
     res = plan_foot_kernel(req.elevation[ch], req.ground[ch], req.forbidden[ch], req.origins[ch, 0],
                            req.origins[ch, 1], offsets, req.sources[i], req.preferred[i], req.hips[i], req.reach_xz[i],
                            req.step_height[i], req.legs[req.legs_start[i]:req.legs_start[i + 1]], req.block_radius[i], w,
-                           cfg, req.couples_after_first[i], req.slice_size[i], req.early[i], mode)
+                           cfg, req.couples_after_first[i], req.slice_size[i], req.early[i], mode, req.foot_shape[i])
     out.valid[i] = res.valid
     out.target[i, :] = res.target_xyz
     out.slice_index[i] = res.slice_index

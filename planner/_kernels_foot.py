@@ -24,7 +24,7 @@ import numba as nb
 import numpy as np
 
 from footfall.planner._grid import cell_centre, cell_of
-from footfall.planner._kernels_geometry import segment_point_distance, segments_cross, supercover_visit
+from footfall.planner._kernels_geometry import rect_overlaps_aabb, segment_point_distance, segments_cross, supercover_visit
 from footfall.planner._kernels_wavefront import chamfer_distance
 from footfall.planner._weights import (
     N_FOOTPRINT_TERMS,
@@ -45,6 +45,7 @@ from footfall.planner._weights import (
 # The raw trajectory metrics (RAW_*), footprint features (FEAT_*) and counters (CNT_*), in the order of the
 # results: planner.layout.
 from footfall.planner.layout import (  # noqa: F401  (re-exported: the kernels' callers read them from here too)
+    CNT_BOXED,
     CNT_CANDIDATES,
     CNT_COUPLES_2D,
     CNT_COUPLES_3D,
@@ -102,6 +103,16 @@ planned to pass 0.5-2 mm beside another's foot crossed it as soon as the body tu
 crowded runs (crates-moving 12 x 600, mixed 8 x 600 frames) leg crossings 786 -> 120 pair-frames, feet
 in crates 494 -> 223; the whole room (the rule of a footprint under another leg's projection) held
 the feet so often that feet in crates tripled (1607)."""
+BOXED_CELL_COST = 10.0
+"""x a free cell's cost: what a cell of another foot's room, another leg's projection or a forbidden
+box's foot-size ring costs the way out of a boxed-in foot (:func:`slice_maps` with ``boxed``), so
+that way passes as few of them as it can. A foot whose every way to its candidates ran through them
+(another foot beside it, the corner of a crate on its other side) found no couple, held, and held its
+body: a spider's trailing foot stood 7 cm beside its neighbour's with a crate's corner in front and
+the spider froze for 2 s (``crates``, seed 3007). The way is checked on the geometry itself: it
+crosses no other leg (:func:`path_crosses_legs`) and the foot at none of its samples touches a
+forbidden cell (:func:`path_touches_forbidden`; the ring is a foot centred *anywhere* in a cell, a
+7 cm cell's centre is 2.5 cm from a crate for a spider's foot)."""
 MAX_SLICES = 12
 MAX_DENSE = 1024  # samples of one path; a longer path is refused
 DENSE_SPACING = 0.35  # target spacing of dense samples, in cells
@@ -510,20 +521,31 @@ def swing_reach(r0, c0, hp, wp, origin_x, origin_z, cell, source_x, source_z, hi
         out[p] = math.hypot(cx - hip_x, cz - hip_z) <= radius
 
 
+@nb.njit(cache=True, inline="always")
+def _boxed_way(c):
+    """A cell a boxed-in foot's way out may pass (:data:`BOXED_CELL_COST`)."""
+    return c == OTHER_LEG or c == SIZE_INCREASE
+
+
 @nb.njit(cache=True)
 def slice_maps(code, boxh_dil, level, eps, source_p, in_reach, hp, wp, cell, pot_range, pot_gain, passable, factor,
-               dt):
+               dt, boxed=False):
     """Passable cells, potential-field cost factors and distance to blocked cells for one slice.
 
     A cell out of the swing's reach (``in_reach``, :func:`swing_reach`) is not passable, but it
-    blocks nothing: the distance to obstacles (clearance, potential field) ignores it."""
+    blocks nothing: the distance to obstacles (clearance, potential field) ignores it.
+
+    ``boxed``: the way out of a boxed-in foot (no candidate reachable otherwise): the cells of other
+    feet's room and other legs' projections (``OTHER_LEG``) and the foot-size ring of forbidden boxes
+    (``SIZE_INCREASE``) within reach are passable too, at :data:`BOXED_CELL_COST` x their cost; they
+    still count as obstacles for the clearance."""
     n = hp * wp
     inside = np.empty(n, dtype=np.uint8)
     blocked = np.empty(n, dtype=np.uint8)
     for p in range(n):
         inside[p] = code[p] != PAD
         ok = code[p] == FREE and boxh_dil[p] <= level + eps
-        passable[p] = (ok and in_reach[p]) or p == source_p
+        passable[p] = ((ok or (boxed and _boxed_way(code[p]))) and in_reach[p]) or p == source_p
         blocked[p] = inside[p] and not ok
     if code[source_p] != FREE or boxh_dil[source_p] > level + eps:
         _open_escape(passable, blocked, inside, source_p, wp, code)
@@ -534,6 +556,44 @@ def slice_maps(code, boxh_dil, level, eps, source_p, in_reach, hp, wp, cell, pot
             factor[p] = 1.0 + pot_gain * g * g
         else:
             factor[p] = 1.0
+        if boxed and _boxed_way(code[p]):
+            factor[p] *= BOXED_CELL_COST
+
+
+@nb.njit(cache=True)
+def path_crosses_legs(points, n, col_z, other_legs):
+    """The polyline ``points[:n]`` (x in column 0, z in ``col_z``) crosses the ground projection
+    (hip -> foot) of one of ``other_legs``. A boxed-in foot's way out passes cells of other legs'
+    projections (:func:`slice_maps`), so its paths are checked on the segments themselves."""
+    for i in range(n - 1):
+        for j in range(other_legs.shape[0]):
+            if segments_cross(points[i, 0], points[i, col_z], points[i + 1, 0], points[i + 1, col_z], other_legs[j, 0],
+                              other_legs[j, 1], other_legs[j, 2], other_legs[j, 3]):
+                return True
+    return False
+
+
+@nb.njit(cache=True)
+def path_touches_forbidden(points, n, col_z, forbidden, origin_x, origin_z, cell, foot_shape):
+    """The foot (``foot_shape``: length, width, yaw) centred at one of the samples ``points[:n]`` (x in
+    column 0, z in ``col_z``) overlaps a forbidden cell's square (or leaves the map)."""
+    hx = 0.5 * foot_shape[0]
+    hz = 0.5 * foot_shape[1]
+    yaw = foot_shape[2]
+    reach = int(math.ceil(math.hypot(hx, hz) / cell)) + 1
+    n_rows, n_cols = forbidden.shape
+    for i in range(n):
+        x = points[i, 0]
+        z = points[i, col_z]
+        r, c = cell_of(x, z, origin_x, origin_z, cell)
+        for dr in range(-reach, reach + 1):
+            for dc in range(-reach, reach + 1):
+                cx, cz = cell_centre(r + dr, c + dc, origin_x, origin_z, cell)
+                if not rect_overlaps_aabb(x, z, hx, hz, yaw, cx, cz, 0.5 * cell, 0.5 * cell):
+                    continue
+                if r + dr < 0 or r + dr >= n_rows or c + dc < 0 or c + dc >= n_cols or forbidden[r + dr, c + dc]:
+                    return True
+    return False
 
 
 @nb.njit(cache=True, inline="always")

@@ -23,6 +23,14 @@ Search (``MODE_SEARCH``)
     With no budget limit and no early termination the result is the optimum
     over all (target, slice) couples.
 
+Boxed-in foot
+    when no candidate is reachable in any slice, one more pass over the first
+    slice lets the path through the room of other feet and the projections of
+    other legs, and the foot-size ring of forbidden boxes, at
+    :data:`planner._kernels_foot.BOXED_CELL_COST` x the cost (a path that
+    crosses a leg's segment itself, or where the foot touches a forbidden cell,
+    is refused); its couple counts in ``boxed_ways``. Without one the foot holds (the defined fallback).
+
 ``MODE_PER_TARGET`` is the same search with one wavefront per (target, slice)
 (for benchmarks); ``MODE_BRUTE_FORCE`` scores every (target, slice) couple in
 3D with no pruning (the reference the tests compare the search with).
@@ -33,6 +41,7 @@ Harvest (:func:`harvest_foot_kernel`, for tuning/)
     couple its raw trajectory metrics, goodnesses and scores. It reuses the
     search's pieces (``foot_setup``, ``couple_metrics_2d/3d``, the goodness
     functions of :mod:`planner._kernels_foot`), so its numbers are the search's.
+    It has no boxed-in pass: a boxed foot's way out is a fallback, not a scored choice.
 """
 
 from __future__ import annotations
@@ -45,6 +54,7 @@ import numpy as np
 
 from footfall.planner._grid import cell_centre, cell_of
 from footfall.planner._kernels_foot import (
+    CNT_BOXED,
     CNT_CANDIDATES,
     CNT_COUPLES_2D,
     CNT_COUPLES_3D,
@@ -66,6 +76,8 @@ from footfall.planner._kernels_foot import (
     drawn_heights,
     elevate_3d,
     footprint_candidates,
+    path_crosses_legs,
+    path_touches_forbidden,
     prepare_foot,
     resample_by_arclength,
     slice_levels,
@@ -152,10 +164,19 @@ def directness_references(cand_xz, source_x, source_z, cell):
 
 
 @nb.njit(cache=True)
+def _boxed_way_refused(points, n, col_z, other_legs, forbidden, origin_x, origin_z, cell, foot_shape):
+    """A boxed-in foot's way (its samples ``points[:n]``) crosses another leg or touches a forbidden cell."""
+    return (path_crosses_legs(points, n, col_z, other_legs)
+            or path_touches_forbidden(points, n, col_z, forbidden, origin_x, origin_z, cell, foot_shape))
+
+
+@nb.njit(cache=True)
 def plan_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, source, preferred, hip, reach_xz,
                      step_height, other_legs, feet_block_radius, w, cfg, couples_after_first, slice_size,
-                     paper_early_stop, mode):
-    """Plan one foot. See the module docstring; returns a :data:`CoupleOut`."""
+                     paper_early_stop, mode, foot_shape):
+    """Plan one foot (``foot_shape``: length, width, yaw; ``offsets`` its size-increase stencil,
+    :func:`planner._kernels_geometry.foot_offsets`). See the module docstring; returns a
+    :data:`CoupleOut`."""
     cell = cfg[C_CELL]
     eps = cfg[C_SLICE_EPS]
     k_out = int(cfg[C_SAMPLES])
@@ -214,90 +235,105 @@ def plan_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, 
     first_found = False
     after_first = 0
     done = False
+    boxed_pass = False
 
-    for k in range(n_cand):
-        if done:
-            break
-        if mode != MODE_BRUTE_FORCE and best_k >= 0 and suffix_ub[k] <= best_score:
-            break
-        tp = cand[k]
-        target_y = elev_dil[tp]
-        tx = cand_xz[k, 0]
-        tz = cand_xz[k, 1]
-        evaluated_3d = False
-        improved = False
-        for s in range(n_slices):
-            if boxh_dil[tp] > levels[s] + eps:
-                continue  # the target itself is above this slice: not reachable in it
-            if not ready[s]:
-                slice_maps(code, boxh_dil, levels[s], eps, source_p, in_reach, hp, wp, cell, cfg[C_POT_RANGE],
-                           cfg[C_POT_GAIN], passable[s], factor[s], dt[s])
-                if mode == MODE_SEARCH:
-                    m = 0
-                    for q in range(n_cand):
-                        if boxh_dil[cand[q]] <= levels[s] + eps:
-                            stop[m] = cand[q]
-                            m += 1
-                    counters[CNT_EXPANDED] += wavefront(passable[s], factor[s], wp, source_p, cell, stop[:m], dist[s],
-                                                        parent[s])
-                    counters[CNT_WAVEFRONTS] += 1
-                ready[s] = 1
-            if mode != MODE_SEARCH:
-                one[0] = tp
-                counters[CNT_EXPANDED] += wavefront(passable[s], factor[s], wp, source_p, cell, one, dist[s], parent[s])
-                counters[CNT_WAVEFRONTS] += 1
-            if not math.isfinite(dist[s, tp]):
-                continue
-            nd, len2, curv, clear, climb2 = couple_metrics_2d(
-                parent[s], passable[s], dt[s], elev_dil, code, source_p, tp, source_x, source_y, source_z, tx, target_y,
-                tz, step_height, r0, c0, hp, wp, origin_x, origin_z, cell, dense, dense_p, g_free, rows, cols)
-            if nd < 2:
-                continue
-            counters[CNT_COUPLES_2D] += 1
-            for t in range(N_FOOTPRINT_TERMS):
-                terms[t] = cand_terms[k, t]
-            # 2D score: jerk at its best case (goodness 1), 2D length and climb (see module doc).
-            trajectory_goodness(w, terms, d_ref[k], len2, curv, clear, climb2, 0.0)
-            score2 = weighted_mean(w, terms, 0, N_TERMS)
-            if mode != MODE_BRUTE_FORCE and score2 <= best_score:
-                continue
-            len3, climb3, jerk = couple_metrics_3d(dense, nd, len2, source_y, target_y, step_height,
-                                                   cfg[C_OBST_MARGIN], cell, poly, jerk_work)
-            trajectory_goodness(w, terms, d_ref[k], len2, curv, clear, climb3, jerk)
-            score3 = weighted_mean(w, terms, 0, N_TERMS)
-            counters[CNT_COUPLES_3D] += 1
-            evaluated_3d = True
-            if first_found:
-                after_first += 1
-            if score3 > best_score:
-                best_score = score3
-                best_k = k
-                best_s = s
-                best_n = nd
-                best_target_y = target_y
-                improved = True
-                for t in range(N_TERMS):
-                    best_terms[t] = terms[t]
-                best_raw[RAW_LENGTH] = len2
-                best_raw[RAW_CURVATURE] = curv
-                best_raw[RAW_CLEARANCE] = clear
-                best_raw[RAW_CLIMB] = climb3
-                best_raw[RAW_JERK] = jerk
-                drawn = poly
-                if drawn_heights(dense, g_free, nd, source_y + ESCAPE_RISE * step_height, dense_drawn):
-                    elevate_3d(dense_drawn, nd, len2, source_y, target_y, step_height, cfg[C_OBST_MARGIN], cell,
-                               poly_drawn)
-                    drawn = poly_drawn
-                for i in range(nd):
-                    best_poly[i, 0] = drawn[i, 0]
-                    best_poly[i, 1] = drawn[i, 1]
-                    best_poly[i, 2] = drawn[i, 2]
-            first_found = True
-            if mode != MODE_BRUTE_FORCE and couples_after_first >= 0 and after_first >= couples_after_first:
-                done = True
+    for boxed in (False, True):
+        if boxed:
+            if best_k >= 0 or n_cand == 0:
                 break
-        if mode != MODE_BRUTE_FORCE and paper_early_stop and evaluated_3d and not improved:
-            break
+            # The way out of a boxed-in foot (planner._kernels_foot.BOXED_CELL_COST): no candidate was
+            # reachable, so one more wavefront over everything (the first slice) may pass through the
+            # room of other feet and the projections of other legs, at a cost.
+            pass_slices = 1
+            ready[0] = 0
+            done = False
+            boxed_pass = True
+        else:
+            pass_slices = n_slices
+        for k in range(n_cand):
+            if done:
+                break
+            if mode != MODE_BRUTE_FORCE and best_k >= 0 and suffix_ub[k] <= best_score:
+                break
+            tp = cand[k]
+            target_y = elev_dil[tp]
+            tx = cand_xz[k, 0]
+            tz = cand_xz[k, 1]
+            evaluated_3d = False
+            improved = False
+            for s in range(pass_slices):
+                if boxh_dil[tp] > levels[s] + eps:
+                    continue  # the target itself is above this slice: not reachable in it
+                if not ready[s]:
+                    slice_maps(code, boxh_dil, levels[s], eps, source_p, in_reach, hp, wp, cell, cfg[C_POT_RANGE],
+                               cfg[C_POT_GAIN], passable[s], factor[s], dt[s], boxed)
+                    if mode == MODE_SEARCH:
+                        m = 0
+                        for q in range(n_cand):
+                            if boxh_dil[cand[q]] <= levels[s] + eps:
+                                stop[m] = cand[q]
+                                m += 1
+                        counters[CNT_EXPANDED] += wavefront(passable[s], factor[s], wp, source_p, cell, stop[:m], dist[s],
+                                                            parent[s])
+                        counters[CNT_WAVEFRONTS] += 1
+                    ready[s] = 1
+                if mode != MODE_SEARCH:
+                    one[0] = tp
+                    counters[CNT_EXPANDED] += wavefront(passable[s], factor[s], wp, source_p, cell, one, dist[s], parent[s])
+                    counters[CNT_WAVEFRONTS] += 1
+                if not math.isfinite(dist[s, tp]):
+                    continue
+                nd, len2, curv, clear, climb2 = couple_metrics_2d(
+                    parent[s], passable[s], dt[s], elev_dil, code, source_p, tp, source_x, source_y, source_z, tx, target_y,
+                    tz, step_height, r0, c0, hp, wp, origin_x, origin_z, cell, dense, dense_p, g_free, rows, cols)
+                if nd < 2 or (boxed and _boxed_way_refused(dense, nd, 1, other_legs, forbidden, origin_x, origin_z,
+                                                           cell, foot_shape)):
+                    continue
+                counters[CNT_COUPLES_2D] += 1
+                for t in range(N_FOOTPRINT_TERMS):
+                    terms[t] = cand_terms[k, t]
+                # 2D score: jerk at its best case (goodness 1), 2D length and climb (see module doc).
+                trajectory_goodness(w, terms, d_ref[k], len2, curv, clear, climb2, 0.0)
+                score2 = weighted_mean(w, terms, 0, N_TERMS)
+                if mode != MODE_BRUTE_FORCE and score2 <= best_score:
+                    continue
+                len3, climb3, jerk = couple_metrics_3d(dense, nd, len2, source_y, target_y, step_height,
+                                                       cfg[C_OBST_MARGIN], cell, poly, jerk_work)
+                trajectory_goodness(w, terms, d_ref[k], len2, curv, clear, climb3, jerk)
+                score3 = weighted_mean(w, terms, 0, N_TERMS)
+                counters[CNT_COUPLES_3D] += 1
+                evaluated_3d = True
+                if first_found:
+                    after_first += 1
+                if score3 > best_score:
+                    best_score = score3
+                    best_k = k
+                    best_s = s
+                    best_n = nd
+                    best_target_y = target_y
+                    improved = True
+                    for t in range(N_TERMS):
+                        best_terms[t] = terms[t]
+                    best_raw[RAW_LENGTH] = len2
+                    best_raw[RAW_CURVATURE] = curv
+                    best_raw[RAW_CLEARANCE] = clear
+                    best_raw[RAW_CLIMB] = climb3
+                    best_raw[RAW_JERK] = jerk
+                    drawn = poly
+                    if drawn_heights(dense, g_free, nd, source_y + ESCAPE_RISE * step_height, dense_drawn):
+                        elevate_3d(dense_drawn, nd, len2, source_y, target_y, step_height, cfg[C_OBST_MARGIN], cell,
+                                   poly_drawn)
+                        drawn = poly_drawn
+                    for i in range(nd):
+                        best_poly[i, 0] = drawn[i, 0]
+                        best_poly[i, 1] = drawn[i, 1]
+                        best_poly[i, 2] = drawn[i, 2]
+                first_found = True
+                if mode != MODE_BRUTE_FORCE and couples_after_first >= 0 and after_first >= couples_after_first:
+                    done = True
+                    break
+            if mode != MODE_BRUTE_FORCE and paper_early_stop and evaluated_3d and not improved:
+                break
 
     trajectory = np.empty((k_out, 3), dtype=np.float64)
     target_rc = np.full(2, -1, dtype=np.int64)
@@ -306,6 +342,11 @@ def plan_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, 
     valid = best_k >= 0
     if valid:
         resample_by_arclength(best_poly, best_n, k_out, trajectory)
+        # The chords between a boxed way's samples may cut a corner of its path across a leg.
+        valid = not (boxed_pass and _boxed_way_refused(trajectory, k_out, 2, other_legs, forbidden, origin_x, origin_z,
+                                                        cell, foot_shape))
+    if valid:
+        counters[CNT_BOXED] = boxed_pass
         target_rc[0] = cand_rc[best_k, 0]
         target_rc[1] = cand_rc[best_k, 1]
         target_xyz[0] = cand_xz[best_k, 0]

@@ -253,7 +253,8 @@ def plan_foot(maps: LocalMaps, query: FootQuery, weights: ScoringWeights | None 
         maps.elevation, maps.ground, maps.forbidden, maps.frame.origin_x, maps.frame.origin_z, offsets,
         query.source, query.preferred, query.hip, float(query.reach_xz), float(query.step_height),
         query.other_legs, query.feet_block_radius, weights.to_array(), config.to_array(),
-        couples_after_first, slice_size, early, MODES[mode])
+        couples_after_first, slice_size, early, MODES[mode],
+        np.array([query.foot_length, query.foot_width, query.foot_yaw], dtype=np.float64))
     return CoupleResult(
         valid=bool(out.valid), target_cell=(int(out.target_rc[0]), int(out.target_rc[1])), target=out.target_xyz,
         slice_index=int(out.slice_index), slice_level_m=float(out.slice_level),

@@ -36,6 +36,7 @@ from footfall._atomic import atomic_path
 from footfall.planner._crowd import STAGES, CrowdModel, CrowdState, _rot_xz, step
 from footfall.planner._counters import FrameCounters
 from footfall.planner._weights import N_TERMS
+from footfall.planner.layout import COUNTERS, N_COUNTERS
 
 RECORDING_FORMAT = "footfall-recording"
 RECORDING_VERSION = 1
@@ -78,6 +79,9 @@ class SimulationSummary:
     plans, holds, replans, cells_expanded, couples_evaluated : int
         The planner's work: feet planned, new requests held for want of a couple, re-plans,
         wavefront cells expanded, couples scored.
+    boxed_ways : int
+        New steps whose couple is a boxed-in foot's way out, through other feet's room, other legs'
+        projections or a forbidden box's foot-size ring (:data:`planner._kernels_foot.BOXED_CELL_COST`).
     finite : bool
         Every pose of the run was finite.
     stride_rel_error_median, stride_rel_error_p90 : float or None
@@ -133,6 +137,7 @@ class SimulationSummary:
     speed_reached: float = 0.0
     duty_factor_mean: float | None = None
     gait_fractions: dict = field(default_factory=dict)
+    boxed_ways: int = 0
     body_overlaps: int = 0
     shared_foot_spots: int = 0
     stuck_seconds: float = 0.0
@@ -252,7 +257,7 @@ class Recorder:
     def save(self, path, model: CrowdModel, summary: SimulationSummary, meta: dict) -> None:
         from footfall import __version__
 
-        width = 5 + 3 + 3 + N_TERMS + 6 + 1
+        width = 5 + 3 + 3 + N_TERMS + N_COUNTERS + 1
         events = np.concatenate(self.events) if self.events else np.zeros((0, width))
         header = {"format": RECORDING_FORMAT, "version": RECORDING_VERSION, "footfall": __version__,
                   "dt": model.dt, "creature": model.creature.name, "leg_names": list(model.creature.leg_names),
@@ -260,8 +265,7 @@ class Recorder:
                   "event_columns": ["frame", "character", "leg", "kind", "valid", "target_x", "target_y", "target_z",
                                     "couple_score", "footprint_score", "trajectory_score"]
                   + [f"term_{i}" for i in range(N_TERMS)]
-                  + ["couples_evaluated", "couples_2d", "cells_expanded", "wavefronts", "candidates", "slices",
-                     "slice_level_m"], **meta}
+                  + list(COUNTERS) + ["slice_level_m"], **meta}
         if model.creature.source_toml is not None:  # a user's creature file travels with its recording
             header["creature_toml"] = model.creature.source_toml
         with atomic_path(path, suffix=".npz") as tmp:
@@ -586,7 +590,7 @@ def simulate(model: CrowdModel, state: CrowdState, frames: int, recorder: Record
         forbidden_footprints=int(c["forbidden_footprints"]), leg_crossings=counters.leg_crossings, max_stance_slip_m=counters.max_stance_slip_m,
         ik_residual_p95_m=counters.ik_residual_p95(), ms_per_frame_median=float(np.median(frame_ms)), ms_per_frame_mean=float(np.mean(frame_ms)),
         stage_ms_median={s: float(1e3 * np.median(stage_s[:, i])) for i, s in enumerate(STAGES)},
-        plans=int(c["plans"]), holds=int(c["holds"]), replans=int(c["replans"]),
+        plans=int(c["plans"]), holds=int(c["holds"]), replans=int(c["replans"]), boxed_ways=int(c["boxed_ways"]),
         cells_expanded=int(c["cells_expanded"]), couples_evaluated=int(c["couples_evaluated"]), finite=finite,
         stride_rel_error_median=median, stride_rel_error_p90=p90, strides_measured=measured,
         speed_asked=float(model.speed_asked), speed_cap=None if math.isinf(model.speed_cap) else float(model.speed_cap),

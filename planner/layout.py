@@ -81,9 +81,11 @@ forbidden box, another character's body or the world's edge; a moving forbidden 
 a moving box may swing out through its cells, beside a static one never
 (:func:`planner._kernels_foot._open_escape`)."""
 
-COUNTERS: tuple[str, ...] = ("couples_evaluated", "couples_2d", "cells_expanded", "wavefronts", "candidates", "slices")
-"""The search's counters of one foot."""
-CNT_COUPLES_3D, CNT_COUPLES_2D, CNT_EXPANDED, CNT_WAVEFRONTS, CNT_CANDIDATES, CNT_SLICES = range(len(COUNTERS))
+COUNTERS: tuple[str, ...] = ("couples_evaluated", "couples_2d", "cells_expanded", "wavefronts", "candidates", "slices",
+                              "boxed_ways")
+"""The search's counters of one foot (``boxed_ways``: 1 when its couple is a boxed-in foot's way out,
+:data:`planner._kernels_foot.BOXED_CELL_COST`)."""
+CNT_COUPLES_3D, CNT_COUPLES_2D, CNT_EXPANDED, CNT_WAVEFRONTS, CNT_CANDIDATES, CNT_SLICES, CNT_BOXED = range(len(COUNTERS))
 N_COUNTERS = len(COUNTERS)
 
 SCORES: tuple[str, ...] = ("couple", "footprint", "trajectory")
@@ -104,7 +106,7 @@ assert len(SCORE_TERMS) == N_TERMS and N_FOOTPRINT_TERMS == len(FOOTPRINT_TERMS)
 
 __all__ = [
     "C_CELL", "C_MARGIN", "C_OBST_MARGIN", "C_POT_GAIN", "C_POT_RANGE", "C_RADIUS", "C_SAMPLES", "C_SLICE_EPS",
-    "CNT_CANDIDATES", "CNT_COUPLES_2D", "CNT_COUPLES_3D", "CNT_EXPANDED", "CNT_SLICES", "CNT_WAVEFRONTS",
+    "CNT_BOXED", "CNT_CANDIDATES", "CNT_COUPLES_2D", "CNT_COUPLES_3D", "CNT_EXPANDED", "CNT_SLICES", "CNT_WAVEFRONTS",
     "CONFIG_FIELDS", "COUNTERS",
     "FEAT_DISTANCE", "FEAT_LEG_GAP", "FEAT_PROXIMITY", "FEAT_ROUGHNESS", "FEAT_SLOPE", "FEATURES",
     "FOOTPRINT_TERMS", "KIND_FORCED_STEP", "KIND_NEW_SWING", "KIND_NONE", "KIND_REPLAN", "MODE_BRUTE_FORCE", "MODE_PER_TARGET", "MODE_SEARCH",

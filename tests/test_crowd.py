@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from conftest import footfall_cli
 
-from footfall.planner import PlannerConfig, WorldRaster
+from footfall.planner import COUNTERS, PlannerConfig, WorldRaster
 from footfall.planner._crowd import hips_world, init_crowd, planner_config_for
 from footfall.planner._simulation import Recorder, simulate
 from footfall.scenarios import builtin_creature_names, builtin_scenario_names, default_gait_name, load_creature, load_gait, load_scenario
@@ -91,6 +91,10 @@ def test_same_seed_same_recording(tmp_path):
         np.testing.assert_array_equal(a[key], b[key], err_msg=key)
     header = json.loads(str(a["header"]))
     assert header["format"] == "footfall-recording" and header["version"] == 1
+    # One column per name, every search counter among them (a counter added to planner.layout once
+    # left the names one short of the events: every recording of that runtime was refused).
+    assert a["events"].shape == (a["events"].shape[0], len(header["event_columns"])) and a["events"].shape[0] > 0
+    assert set(COUNTERS) <= set(header["event_columns"])
 
 
 def test_a_raster_given_for_reuse_gives_the_run_it_would_have_without_it():

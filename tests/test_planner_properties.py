@@ -205,6 +205,53 @@ def test_boxed_in_foot_holds():
     np.testing.assert_array_equal(r.trajectory, np.repeat(q.source[None], len(r.trajectory), axis=0))
 
 
+# A corridor along z 1.0-1.1 (row 10) of 0.1 m cells: forbidden rows 8 and 12, their foot-size rings
+# rows 9 and 11. The foot stands at x 0.55 and steps to x 1.05 under a hip at x 0.85.
+CORRIDOR_FORBIDDEN = np.zeros((20, 20), np.uint8)
+CORRIDOR_FORBIDDEN[[8, 12], :] = 1
+
+
+def _corridor_query(legs):
+    return FootQuery(source=(0.55, 0.0, 1.05), preferred=(1.05, 1.05), hip=(0.85, 1.05), reach_xz=0.45,
+                     step_height=0.05, foot_length=0.04, foot_width=0.02, foot_yaw=0.0,
+                     other_legs=np.array(legs, float).reshape(-1, 4))
+
+
+def _corridor(forbidden=CORRIDOR_FORBIDDEN):
+    return LocalMaps(GridFrame(0.0, 0.0, 0.1, 20, 20), np.zeros((20, 20)), np.zeros((20, 20)), forbidden)
+
+
+def test_a_boxed_in_foot_steps_past_another_foot_when_no_other_way_is_left():
+    config = PlannerConfig(cell_size=0.1)
+    free = plan_foot(_corridor(), _corridor_query([]), budget=EXHAUSTIVE, config=config)
+    assert free.valid and free.counters["boxed_ways"] == 0
+    # Another foot at x 0.75 closes the corridor (its room is cell (10, 7)): the only way to the
+    # candidates passes over it. The foot takes it rather than hold (and hold its body) for good.
+    foot = [(0.75, 1.05, 0.75, 1.05)]
+    boxed = plan_foot(_corridor(), _corridor_query(foot), budget=EXHAUSTIVE, config=config)
+    assert boxed.valid and boxed.counters["boxed_ways"] == 1
+    np.testing.assert_array_equal(boxed.target, (1.05, 0.0, 1.05))
+    np.testing.assert_allclose(boxed.trajectory[:, 2], 1.05, rtol=0, atol=1e-12)  # along the corridor, over the foot
+    assert boxed.couple_score < free.couple_score  # its clearance is the other foot's room: none
+    # A forbidden cell there instead: the way out passes beside it, through the foot-size rings of the
+    # cell and of the corridor's wall (row 9, z 0.9-1.0, or row 11, z 1.1-1.2), where the 4 x 2 cm foot
+    # touches neither.
+    post = CORRIDOR_FORBIDDEN.copy()
+    post[10, 7] = 1
+    beside = plan_foot(_corridor(post), _corridor_query([]), budget=EXHAUSTIVE, config=config)
+    assert beside.valid and beside.counters["boxed_ways"] == 1
+    np.testing.assert_array_equal(beside.target, (1.05, 0.0, 1.05))
+    at_post = np.abs(beside.trajectory[:, 0] - 0.75) <= 0.05 + 0.02  # samples whose foot may reach x 0.7-0.8
+    side = 0.95 if beside.trajectory[at_post, 2].mean() < 1.05 else 1.15
+    assert at_post.any() and np.all(np.abs(beside.trajectory[at_post, 2] - side) <= 0.05 - 0.01)
+    # A wall across the corridor (rows 9-11 at x 0.7-0.8) is no way out: the foot holds.
+    wall = post.copy()
+    wall[9:12, 7] = 1
+    held = plan_foot(_corridor(wall), _corridor_query([]), budget=EXHAUSTIVE, config=config)
+    assert not held.valid and held.counters["boxed_ways"] == 0
+    np.testing.assert_array_equal(held.target, (0.55, 0.0, 1.05))
+
+
 def test_same_inputs_same_result():
     rng = np.random.default_rng(5)
     maps, _ = random_layout(rng)

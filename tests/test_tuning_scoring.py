@@ -88,7 +88,7 @@ def test_trajectory_goodnesses_and_couple_scores_equal_the_runtime(harvest, jax_
 def test_the_exhaustive_search_pick_is_the_jax_argmax_with_the_same_numbers(harvest, jax_scores):
     ok = harvest.has_couple
     assert (harvest.chosen[ok, 0] >= 0).all()  # a couple exists: the search finds one
-    assert (harvest.chosen[~ok, 0] < 0).all()
+    assert (harvest.chosen[~ok, 0] < 0).all()  # (a boxed-in foot's way out is no harvested couple: no pick)
     f = np.flatnonzero(ok)
     k, s = harvest.chosen[f, 0], harvest.chosen[f, 1]
     n_slices = harvest.couple_mask.shape[2]
