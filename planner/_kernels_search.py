@@ -243,7 +243,8 @@ def plan_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, 
                 break
             # The way out of a boxed-in foot (planner._kernels_foot.BOXED_CELL_COST): no candidate was
             # reachable, so one more wavefront over everything (the first slice) may pass through the
-            # room of other feet and the projections of other legs, at a cost.
+            # room of other feet, the projections of other legs and the foot-size rings of forbidden
+            # boxes, at a cost; its paths are checked on the geometry (_boxed_way_refused).
             pass_slices = 1
             ready[0] = 0
             done = False
