@@ -26,11 +26,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from footfall.planner._kernels_geometry import foot_offsets
 from footfall.planner._kernels_search import MODE_SEARCH, harvest_foot_kernel, plan_foot_kernel
 from footfall.planner._maps import LocalMaps
 from footfall.planner._params import DEFAULT_BUDGET, PlannerConfig, SearchBudget
-from footfall.planner._search import FootQuery, checked_foot_offsets
+from footfall.planner._search import FootQuery, checked_foot_shape
 from footfall.planner._threads import single_threaded
 from footfall.planner._weights import N_FOOTPRINT_TERMS, N_TERMS, ScoringWeights
 from footfall.planner.layout import CNT_BOXED, FEATURES, N_FEATURES, N_RAW  # FEATURES: the order of ``cand_features``
@@ -94,9 +93,9 @@ class FootHarvest:
     couple_scores: np.ndarray  # (n, S, 3) couple, footprint, trajectory scores (the runtime's)
 
 
-def _harvest_kernel_call(elevation, ground, forbidden, origin_x, origin_z, offsets, source, preferred, hip, reach_xz,
+def _harvest_kernel_call(elevation, ground, forbidden, origin_x, origin_z, foot_shape, source, preferred, hip, reach_xz,
                          step_height, legs, block_radius, w, cfg, slice_size) -> FootHarvest:
-    out = harvest_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, source, preferred, hip,
+    out = harvest_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, foot_shape, source, preferred, hip,
                               reach_xz, step_height, legs, block_radius, w, cfg, slice_size)
     rc, xyz, feats, terms, scores, levels, d_ref, valid, raw, cterms, cscores = out
     return FootHarvest(rc, xyz, feats, terms, scores, levels, d_ref, valid, raw, cterms, cscores)
@@ -150,10 +149,10 @@ def harvest_foot(maps: LocalMaps, query: FootQuery, weights: ScoringWeights | No
     """
     weights = weights or ScoringWeights()
     config = config or PlannerConfig()
-    offsets = checked_foot_offsets(maps, query, config)
+    foot_shape = checked_foot_shape(maps, query, config)
     _, slice_size, _ = budget.kernel_args()
     return _harvest_kernel_call(maps.elevation, maps.ground, maps.forbidden, maps.frame.origin_x, maps.frame.origin_z,
-                                offsets, query.source, query.preferred, query.hip, float(query.reach_xz),
+                                foot_shape, query.source, query.preferred, query.hip, float(query.reach_xz),
                                 float(query.step_height), query.other_legs, query.feet_block_radius,
                                 weights.to_array(), config.to_array(), slice_size)
 
@@ -275,15 +274,14 @@ def _harvest_batch(batch, weights, config, out, cs, ls, kinds, state, model, met
     lengths = np.asarray(state.gaits.gait_duration)
     for i in range(batch.n_feet):
         ch = int(batch.foot_char[i])
-        offsets = foot_offsets(batch.foot_shape[i, 0], batch.foot_shape[i, 1], batch.foot_shape[i, 2], config.cell_size)
         legs = np.ascontiguousarray(batch.legs[batch.legs_start[i]:batch.legs_start[i + 1]])
         args = (batch.elevation[ch], batch.ground[ch], batch.forbidden[ch], batch.origins[ch, 0], batch.origins[ch, 1],
-                offsets, batch.sources[i], batch.preferred[i], batch.hips[i], float(batch.reach_xz[i]),
+                batch.foot_shape[i], batch.sources[i], batch.preferred[i], batch.hips[i], float(batch.reach_xz[i]),
                 float(batch.step_height[i]), legs, float(batch.block_radius[i]), w, cfg)
         slice_size = float(batch.slice_size[i])
         foot = _harvest_kernel_call(*args, slice_size)
         # The exhaustive search (no couple limit, no early stop) on the same foot and slices.
-        best = plan_foot_kernel(*args, -1, slice_size, False, MODE_SEARCH, batch.foot_shape[i])
+        best = plan_foot_kernel(*args, -1, slice_size, False, MODE_SEARCH)
         chosen = (-1, -1)
         if best.valid and not best.counters[CNT_BOXED]:
             chosen = _row_of(foot.cand_cells, foot.levels.size, best.target_rc, int(best.slice_index))

@@ -12,9 +12,7 @@ from collections import namedtuple
 import numba as nb
 import numpy as np
 
-from footfall.planner._kernels_geometry import foot_offsets
 from footfall.planner._kernels_search import plan_foot_kernel
-from footfall.planner._params import C_CELL
 
 FootRequests = namedtuple("FootRequests", [
     "elevation", "ground", "forbidden", "origins",  # the characters' stacked local maps (C, N, N), origins (C, 2)
@@ -33,11 +31,10 @@ FootResults = namedtuple("FootResults", [
 def plan_one_into(i, req, w, cfg, mode, out):
     """Plan foot ``i`` of ``req`` (:data:`FootRequests`) into row ``i`` of ``out`` (:data:`FootResults`)."""
     ch = req.foot_char[i]
-    offsets = foot_offsets(req.foot_shape[i, 0], req.foot_shape[i, 1], req.foot_shape[i, 2], cfg[C_CELL])
     res = plan_foot_kernel(req.elevation[ch], req.ground[ch], req.forbidden[ch], req.origins[ch, 0],
-                           req.origins[ch, 1], offsets, req.sources[i], req.preferred[i], req.hips[i], req.reach_xz[i],
+                           req.origins[ch, 1], req.foot_shape[i], req.sources[i], req.preferred[i], req.hips[i], req.reach_xz[i],
                            req.step_height[i], req.legs[req.legs_start[i]:req.legs_start[i + 1]], req.block_radius[i], w,
-                           cfg, req.couples_after_first[i], req.slice_size[i], req.early[i], mode, req.foot_shape[i])
+                           cfg, req.couples_after_first[i], req.slice_size[i], req.early[i], mode)
     out.valid[i] = res.valid
     out.target[i, :] = res.target_xyz
     out.slice_index[i] = res.slice_index

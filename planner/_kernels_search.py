@@ -53,6 +53,7 @@ import numba as nb
 import numpy as np
 
 from footfall.planner._grid import cell_centre, cell_of
+from footfall.planner._kernels_geometry import foot_offsets
 from footfall.planner._kernels_foot import (
     CNT_BOXED,
     CNT_CANDIDATES,
@@ -116,10 +117,11 @@ def path_workspace(hp, wp):
 
 
 @nb.njit(cache=True)
-def foot_setup(elevation, ground, forbidden, origin_x, origin_z, offsets, source, preferred, hip, reach_xz, other_legs,
-               feet_block_radius, w, cfg, slice_size):
+def foot_setup(elevation, ground, forbidden, origin_x, origin_z, foot_shape, source, preferred, hip, reach_xz,
+               other_legs, feet_block_radius, w, cfg, slice_size):
     """ROI maps, potential footprints, slices and d_ref of one foot (shared by the search and the
-    harvest). Returns (code, elev_dil, boxh_dil, r0, c0, hp, wp, source_p, cand, cand_terms,
+    harvest; ``foot_shape``: length, width, yaw, whose size-increase stencil is
+    :func:`planner._kernels_geometry.foot_offsets`). Returns (code, elev_dil, boxh_dil, r0, c0, hp, wp, source_p, cand, cand_terms,
     cand_scores, cand_features, cand_rc, levels, d_ref (n,), cand_xz, in_reach) - ``cand_xz`` (n, 2) the
     continuous footprints (:func:`planner._kernels_foot.footprint_point`), ``in_reach`` the cells a swing
     may pass (:func:`planner._kernels_foot.swing_reach`)."""
@@ -127,6 +129,7 @@ def foot_setup(elevation, ground, forbidden, origin_x, origin_z, offsets, source
     radius = cfg[C_RADIUS]
     pref_x = preferred[0]
     pref_z = preferred[1]
+    offsets = foot_offsets(foot_shape[0], foot_shape[1], foot_shape[2], cell)
     code, elev_dil, boxh_dil, elev_raw, r0, c0, hp, wp = prepare_foot(
         elevation, ground, forbidden, origin_x, origin_z, cell, offsets, source[0], source[2], pref_x, pref_z, radius,
         int(cfg[C_MARGIN]), other_legs, feet_block_radius)
@@ -171,11 +174,10 @@ def _boxed_way_refused(points, n, col_z, other_legs, forbidden, origin_x, origin
 
 
 @nb.njit(cache=True)
-def plan_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, source, preferred, hip, reach_xz,
+def plan_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, foot_shape, source, preferred, hip, reach_xz,
                      step_height, other_legs, feet_block_radius, w, cfg, couples_after_first, slice_size,
-                     paper_early_stop, mode, foot_shape):
-    """Plan one foot (``foot_shape``: length, width, yaw; ``offsets`` its size-increase stencil,
-    :func:`planner._kernels_geometry.foot_offsets`). See the module docstring; returns a
+                     paper_early_stop, mode):
+    """Plan one foot (``foot_shape``: length, width, yaw). See the module docstring; returns a
     :data:`CoupleOut`."""
     cell = cfg[C_CELL]
     eps = cfg[C_SLICE_EPS]
@@ -185,7 +187,7 @@ def plan_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, 
     source_z = source[2]
     counters = np.zeros(N_COUNTERS, dtype=np.int64)
     (code, elev_dil, boxh_dil, r0, c0, hp, wp, source_p, cand, cand_terms, cand_scores, _, cand_rc, levels,
-     d_ref, cand_xz, in_reach) = foot_setup(elevation, ground, forbidden, origin_x, origin_z, offsets, source,
+     d_ref, cand_xz, in_reach) = foot_setup(elevation, ground, forbidden, origin_x, origin_z, foot_shape, source,
                                             preferred, hip, reach_xz, other_legs, feet_block_radius, w, cfg,
                                             slice_size)
     n = hp * wp
@@ -372,7 +374,7 @@ def plan_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, 
 
 
 @nb.njit(cache=True)
-def harvest_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offsets, source, preferred, hip, reach_xz,
+def harvest_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, foot_shape, source, preferred, hip, reach_xz,
                         step_height, other_legs, feet_block_radius, w, cfg, slice_size):
     """Every candidate couple of one foot (see the module docstring). Returns
 
@@ -391,7 +393,7 @@ def harvest_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, offset
     source_y = source[1]
     source_z = source[2]
     (code, elev_dil, boxh_dil, r0, c0, hp, wp, source_p, cand, cand_terms, cand_scores, cand_features, cand_rc, levels,
-     d_ref, cand_xz, in_reach) = foot_setup(elevation, ground, forbidden, origin_x, origin_z, offsets, source,
+     d_ref, cand_xz, in_reach) = foot_setup(elevation, ground, forbidden, origin_x, origin_z, foot_shape, source,
                                             preferred, hip, reach_xz, other_legs, feet_block_radius, w, cfg,
                                             slice_size)
     n = hp * wp

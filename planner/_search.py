@@ -7,7 +7,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from footfall.planner._kernels_geometry import foot_offsets
 from footfall.planner._kernels_search import MODE_BRUTE_FORCE, MODE_PER_TARGET, MODE_SEARCH, plan_foot_kernel
 from footfall.planner._kernels_wavefront import wavefront
 from footfall.planner._maps import LocalMaps
@@ -172,14 +171,14 @@ class CoupleResult:
     candidate_scores: np.ndarray  # (n,)
 
 
-def checked_foot_offsets(maps: LocalMaps, query: FootQuery, config: PlannerConfig) -> np.ndarray:
-    """Check that ``maps`` and ``query`` fit ``config``; the foot-shape stencil (cell offsets)."""
+def checked_foot_shape(maps: LocalMaps, query: FootQuery, config: PlannerConfig) -> np.ndarray:
+    """Check that ``maps`` and ``query`` fit ``config``; the foot's (length, width, yaw) as the kernels take it."""
     if abs(maps.frame.cell_size - config.cell_size) > 1e-12:
         raise ValueError(f"maps: cell size {maps.frame.cell_size} differs from config.cell_size {config.cell_size}")
     r, c = maps.frame.world_to_cell(query.source[0], query.source[2])
     if not maps.frame.contains_cell(r, c):
         raise ValueError("query.source: outside the local maps")
-    return foot_offsets(query.foot_length, query.foot_width, query.foot_yaw, config.cell_size)
+    return np.array([query.foot_length, query.foot_width, query.foot_yaw], dtype=np.float64)
 
 
 def plan_foot(maps: LocalMaps, query: FootQuery, weights: ScoringWeights | None = None,
@@ -247,14 +246,13 @@ def plan_foot(maps: LocalMaps, query: FootQuery, weights: ScoringWeights | None 
     config = config or PlannerConfig()
     if mode not in MODES:
         raise ValueError(f"mode: expected one of {sorted(MODES)}, got {mode!r}")
-    offsets = checked_foot_offsets(maps, query, config)
+    foot_shape = checked_foot_shape(maps, query, config)
     couples_after_first, slice_size, early = budget.kernel_args()
     out = plan_foot_kernel(
-        maps.elevation, maps.ground, maps.forbidden, maps.frame.origin_x, maps.frame.origin_z, offsets,
+        maps.elevation, maps.ground, maps.forbidden, maps.frame.origin_x, maps.frame.origin_z, foot_shape,
         query.source, query.preferred, query.hip, float(query.reach_xz), float(query.step_height),
         query.other_legs, query.feet_block_radius, weights.to_array(), config.to_array(),
-        couples_after_first, slice_size, early, MODES[mode],
-        np.array([query.foot_length, query.foot_width, query.foot_yaw], dtype=np.float64))
+        couples_after_first, slice_size, early, MODES[mode])
     return CoupleResult(
         valid=bool(out.valid), target_cell=(int(out.target_rc[0]), int(out.target_rc[1])), target=out.target_xyz,
         slice_index=int(out.slice_index), slice_level_m=float(out.slice_level),
