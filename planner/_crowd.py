@@ -1163,7 +1163,7 @@ def stage_gait(model: CrowdModel, state: CrowdState):
     """Stride frequency and duty factor from the speed (the destination disks follow the
     duty factor, the disks in use move toward them while in stance), then the needle."""
     from footfall.planner._gait import advance, set_destination, set_speed
-    from footfall.planner._timing import GRAVITY, stride_length
+    from footfall.planner._timing import GRAVITY, _stride_frequency, stride_length
     from footfall.planner._workspace import duty_ceiling
 
     # Gait changes with speed (planner._gait_schedule): the new gait's disks are the destination.
@@ -1190,16 +1190,20 @@ def stage_gait(model: CrowdModel, state: CrowdState):
     stalled = (state.speed <= 0.0) & (state.speed_wanted > 0.0) & ~state.body_held
     state.stalled_s = np.where(stalled, state.stalled_s + model.dt, 0.0)
     stalled &= state.stalled_s >= STALL_S
+    if stalled.any():
+        frequency = np.where(stalled, np.maximum(frequency, resume_frequency(model, state)), frequency)
     # A body turning on the spot (its way a quarter turn or more off its heading, so that it asks to
-    # walk at ~0) steps at that tempo too: at a standing body's tempo (the 0.5 Hz floor) its stance feet
-    # bounded the turn to 0.2-0.3 rad/s until they swapped, and a quadruped avoiding a neighbour stood
-    # ~2 s coming round (crates-moving, seed 4009; TURNING_FRACTION).
+    # walk at ~0) steps at the tempo of the walk asked of it: at a standing body's tempo (the 0.5 Hz
+    # floor) its stance feet bounded the turn to 0.2-0.3 rad/s until they swapped, and a quadruped
+    # avoiding a neighbour stood ~2 s coming round (crates-moving, seed 4009; TURNING_FRACTION). The
+    # asked walk, not the one its holds taught it to sustain: a robot5 held by a foot its leg could not
+    # follow learnt a limit whose tempo (1.64 -> 0.8-1.0 Hz) bounded its turn to ~0.5 rad/s again.
     ctl = model.controller
     turning = np.abs(state.turn_wanted) >= TURNING_FRACTION * ctl.turn_rate * model.dt
     turning &= (state.speed < TURNING_FRACTION * sustained_speed(state)) & ~state.body_held
-    resume = stalled | turning
-    if resume.any():
-        frequency = np.where(resume, np.maximum(frequency, resume_frequency(model, state)), frequency)
+    if turning.any():
+        asked = _stride_frequency(model.timing, state.desired_speed, model.leg_height)
+        frequency = np.where(turning, np.maximum(frequency, asked), frequency)
     state.stride_frequency = frequency
     in_air = ~state.in_stance
     enter, fraction = advance(state.gaits, frequency, model.dt, state.in_stance)
@@ -1215,7 +1219,7 @@ def stage_gait(model: CrowdModel, state: CrowdState):
 
 
 TURNING_FRACTION = 0.5
-"""A body turns on the spot (:func:`stage_gait`: its needle at the tempo it will resume) while the turn it
+"""A body turns on the spot (:func:`stage_gait`: its needle at the tempo of the walk asked of it) while the turn it
 wants is at least this fraction of its turn rate and its speed under this fraction of the speed it heads
 for. Measured 2026-11-28 (README, crowds and moving boxes): the crowds issue's bar sets (seeds 3000-3009 /
 4000-4009), stuck runs 0 / 8 -> 2 / 2 (4.1 -> 2.0 s in all), per-stride runs 3 / 3 -> 2 / 2, crossing
@@ -1223,7 +1227,11 @@ runs 0 / 1 -> 0 / 1; crowds of 8 / 16 / 64 on ``mixed`` and ``crates`` (spiders,
 3.1 / 12.8 / 54.4 -> 2.0 / 5.5 / 42.0 s, crossing frames 0 / 0 / 4 -> 0; 1000 spiders on ``mixed`` (seeds
 0-2 / 3-5), crossing frames 42 / 41 -> 13 / 19, stuck 77 / 95 -> 118 / 94 s, mean speed 0.19 -> 0.176 m/s.
 Keyed to the asked speed (``speed_wanted``) instead, the bar sets had 5 stuck and 6 per-stride runs and a
-crowd of 16 spiders a collision."""
+crowd of 16 spiders a collision. At the asked walk's tempo rather than the sustained one's (session 44):
+robot5 comes round on the spot in 66-78 frames on seeds 0-299 (67-109 before); the bar sets 10 -> 9
+violations (stuck 4 -> 3, per-stride 4 -> 4, crossings 2 -> 2); the crowds of 8 / 16 / 64 the same bar
+0.7 s more stuck at 64; 1000 spiders (seeds 0-2 / 3-5) stuck 118 / 94 -> 138 / 95 s, crossing frames
+13 / 19 -> 19 / 18 (per-seed spread +-50 %)."""
 
 
 STALL_S = 1.0
