@@ -1229,7 +1229,7 @@ runs 0 / 1 -> 0 / 1; crowds of 8 / 16 / 64 on ``mixed`` and ``crates`` (spiders,
 Keyed to the asked speed (``speed_wanted``) instead, the bar sets had 5 stuck and 6 per-stride runs and a
 crowd of 16 spiders a collision. At the asked walk's tempo rather than the sustained one's (session 44):
 robot5 comes round on the spot in 66-78 frames on seeds 0-299 (67-109 before); the bar sets 10 -> 9
-violations (stuck 4 -> 3, per-stride 4 -> 4, crossings 2 -> 2); the crowds of 8 / 16 / 64 the same bar
+violations (stuck 4 -> 3, per-stride 4 -> 4, crossings 2 -> 2); the crowds of 8 / 16 / 64 the same but for
 0.7 s more stuck at 64; 1000 spiders (seeds 0-2 / 3-5) stuck 118 / 94 -> 138 / 95 s, crossing frames
 13 / 19 -> 19 / 18 (per-seed spread +-50 %)."""
 
