@@ -1066,13 +1066,18 @@ def stance_speed_cap(model: CrowdModel, state: CrowdState) -> np.ndarray:
     return leg_speed_caps(model, state).min(axis=1)
 
 
+def walk_frequency(model: CrowdModel, speed: np.ndarray) -> np.ndarray:
+    """(C,) Hz: the stride frequency of each character walking at ``speed`` (C,) m/s (the timing law)."""
+    from footfall.planner._timing import _stride_frequency
+
+    # Several calls a frame: the checks of the public stride_frequency cost as much as the formula.
+    return _stride_frequency(model.timing, speed, model.leg_height)
+
+
 def resume_frequency(model: CrowdModel, state: CrowdState) -> np.ndarray:
     """(C,) Hz: the stride frequency of the walk each character heads for (its goal speed, within its
     speed limit): the tempo of a body that stands, or speeds up, once it walks."""
-    from footfall.planner._timing import _stride_frequency
-
-    # Three calls a frame: the checks of the public stride_frequency cost as much as the formula.
-    return _stride_frequency(model.timing, sustained_speed(state), model.leg_height)
+    return walk_frequency(model, sustained_speed(state))
 
 
 def leg_speed_caps(model: CrowdModel, state: CrowdState, room=None, lift=None) -> np.ndarray:
@@ -1163,7 +1168,7 @@ def stage_gait(model: CrowdModel, state: CrowdState):
     """Stride frequency and duty factor from the speed (the destination disks follow the
     duty factor, the disks in use move toward them while in stance), then the needle."""
     from footfall.planner._gait import advance, set_destination, set_speed
-    from footfall.planner._timing import GRAVITY, _stride_frequency, stride_length
+    from footfall.planner._timing import GRAVITY, stride_length
     from footfall.planner._workspace import duty_ceiling
 
     # Gait changes with speed (planner._gait_schedule): the new gait's disks are the destination.
@@ -1202,8 +1207,7 @@ def stage_gait(model: CrowdModel, state: CrowdState):
     turning = np.abs(state.turn_wanted) >= TURNING_FRACTION * ctl.turn_rate * model.dt
     turning &= (state.speed < TURNING_FRACTION * sustained_speed(state)) & ~state.body_held
     if turning.any():
-        asked = _stride_frequency(model.timing, state.desired_speed, model.leg_height)
-        frequency = np.where(turning, np.maximum(frequency, asked), frequency)
+        frequency = np.where(turning, np.maximum(frequency, walk_frequency(model, state.desired_speed)), frequency)
     state.stride_frequency = frequency
     in_air = ~state.in_stance
     enter, fraction = advance(state.gaits, frequency, model.dt, state.in_stance)
