@@ -1309,6 +1309,25 @@ def _foot_room(model: CrowdModel) -> float:
     return math.hypot(model.creature.foot_length, model.creature.foot_width)
 
 
+def paths_through_body(model: CrowdModel, state: CrowdState, cs, ls, trajectories, valid) -> np.ndarray:
+    """(F,) bool: valid plans of legs (``cs``, ``ls``) whose swing path (``trajectories`` (F, K, 3))
+    passes further across its body's midline (the line through the pelvis along the heading, now)
+    than both of its ends, and across it at all: a way under the body, between the hips.
+
+    The search keeps a path clear of the other legs' ground lines, not of the body: a quadruped's
+    right front foot, its way ahead blocked by the left front foot (carried across the midline by a
+    turn), was routed round that foot's hip, under the body, and its leg was drawn across the left
+    one (``mixed``, 6 quadrupeds, seed 4009, frame 292). Such a plan waits a frame, as a conflicting
+    one does (:func:`_same_frame_conflicts`). Legs on the midline (a robot5's front leg) have no side.
+    A path starting (or ending) across, a foot coming back to its side, is not refused."""
+    side = np.sign(model.hips_body[ls, 2]) * (np.abs(model.hips_body[ls, 2]) > 1e-3 * model.rest_radius)
+    cos, sin = np.cos(state.heading[cs])[:, None], np.sin(state.heading[cs])[:, None]
+    d = trajectories[:, :, [0, 2]] - state.pelvis[cs][:, None, [0, 2]]
+    own_side = side[:, None] * (-d[..., 0] * sin + d[..., 1] * cos)  # > 0: on the leg's own side
+    deepest = own_side.min(axis=1)
+    return valid & (side != 0.0) & (deepest < np.minimum(0.0, np.minimum(own_side[:, 0], own_side[:, -1])))
+
+
 def _same_frame_conflicts(model: CrowdModel, cs, targets, valid, hips=None) -> np.ndarray:
     """(F,) bool: valid plans whose target lies within a foot's room of an earlier valid plan's target
     (this frame's plans): of another character, or of the same one (two legs of a character planned
@@ -1797,6 +1816,7 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     # foot's room of each other, or two legs of one character whose ground lines would cross, the later
     # one (in plan order) waits a frame and plans again, seeing the other's target.
     ok = out.valid & ~_same_frame_conflicts(model, cs, out.target, out.valid, hip_pred)
+    ok &= ~paths_through_body(model, state, cs, ls, out.trajectory, ok)
     vc, vl = cs[ok], ls[ok]
     state.trajectories[vc, vl] = out.trajectory[ok]
     state.swing_t[vc, vl] = 0.0

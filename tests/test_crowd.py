@@ -516,6 +516,59 @@ def test_two_legs_of_one_character_planned_in_one_frame_with_crossing_lines_conf
     assert _segments_cross(q0, q1, p0, p1).tolist() == [True, False, False, False]
 
 
+def test_a_swing_path_under_the_body_waits():
+    """A plan whose path passes further across its body's midline than both its ends (a way under the
+    body, between the hips) waits a frame (planner._crowd.paths_through_body). A quadruped at the
+    origin facing +x (left is +z): its right front leg (leg 1) from (0.05, -0.22) to (0.65, -0.11),
+    straight, or bent out to z = -0.3, keeps to its side; bent to z = +0.19 it is refused. A path
+    from across the midline back to its side (z +0.05 -> -0.11), an invalid plan, and a robot5's
+    front leg (its hip on the midline) are not."""
+    from footfall.planner._crowd import paths_through_body
+
+    def plans(creature_name, leg, bends):
+        creature = load_creature(creature_name)
+        model, state = init_crowd(load_scenario("flat"), creature, load_gait(default_gait_name(creature_name), creature),
+                                  n_characters=1, seed=0, lod_mode="off")
+        state.pelvis[0, [0, 2]] = 0.0
+        state.heading[0] = 0.0
+        u = np.linspace(0.0, 1.0, 9)
+        paths = []
+        for z0, z1, bend in bends:
+            z = z0 + (z1 - z0) * u + bend * np.sin(np.pi * u)
+            paths.append(np.stack([0.05 + 0.6 * u, np.zeros_like(u), z], axis=1))
+        f = len(bends)
+        return model, state, np.zeros(f, np.int64), np.full(f, leg), np.array(paths)
+
+    bends = [(-0.22, -0.11, 0.0), (-0.22, -0.11, -0.15), (-0.22, -0.11, 0.355), (0.05, -0.11, 0.0)]
+    model, state, cs, ls, paths = plans("quadruped", 1, bends)
+    valid = np.ones(4, np.bool_)
+    assert paths[2, :, 2].max() == pytest.approx(0.19)
+    assert paths_through_body(model, state, cs, ls, paths, valid).tolist() == [False, False, True, False]
+    assert paths_through_body(model, state, cs, ls, paths, ~valid).tolist() == [False] * 4
+    # The same paths for the left front leg (leg 0), and for leg 1 of the body turned a half turn (its
+    # right side is then +z): the paths lie across the midline, and only the one bent out to z = -0.3
+    # goes further across than its ends.
+    assert paths_through_body(model, state, cs, np.zeros(4, np.int64), paths, valid).tolist() == [
+        False, True, False, False]
+    state.heading[0] = np.pi
+    assert paths_through_body(model, state, cs, ls, paths, valid).tolist() == [False, True, False, False]
+    model, state, cs, ls, paths = plans("robot5", 0, bends)
+    assert paths_through_body(model, state, cs, ls, paths, valid).tolist() == [False] * 4
+
+
+def test_the_quadruped_whose_front_leg_was_routed_under_its_body_keeps_its_legs_uncrossed():
+    # mixed, 6 quadrupeds, seed 4009 (footfall evaluate's bar set, 2026-11-28): escaping a moving box
+    # while turning at the full rate, character 3's left front foot was carried across the midline, and
+    # the right front foot's way ahead, blocked by it, was routed round its hip under the body: the two
+    # legs were drawn crossed at frames 292-293. The plan under the body waits (two frames) and the
+    # right foot then steps by its own side.
+    from footfall.reports._evaluate import run_one
+
+    run = run_one({"scenario": "mixed", "creature": "quadruped", "seed": 4009, "characters": 6, "frames": 300,
+                   "lod": "off"})
+    assert run["violations"]["leg_crossings"] == 0
+
+
 def test_a_stance_leg_carried_across_another_leg_steps():
     # Two neighbouring stance feet of a standing spider swapped (as a body turning over its feet
     # carries them): their drawn legs cross, and the controller asks both to step now (kind 2, a
