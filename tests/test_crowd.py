@@ -519,10 +519,11 @@ def test_two_legs_of_one_character_planned_in_one_frame_with_crossing_lines_conf
 def test_a_swing_path_under_the_body_waits():
     """A plan whose path passes further across its body's midline than both its ends (a way under the
     body, between the hips) waits a frame (planner._crowd.paths_through_body). A quadruped at the
-    origin facing +x (left is +z): its right front leg (leg 1) from (0.05, -0.22) to (0.65, -0.11),
-    straight, or bent out to z = -0.3, keeps to its side; bent to z = +0.19 it is refused. A path
-    from across the midline back to its side (z +0.05 -> -0.11), an invalid plan, and a robot5's
-    front leg (its hip on the midline) are not."""
+    origin facing +x (left is +z; its body box 0.6 m long): its right front leg (leg 1) from
+    (-0.1, -0.22) to (0.5, -0.11), straight, or bent out to z = -0.3, keeps to its side; bent to
+    z = +0.19 it is refused. The same bent path 0.8 m further back (behind the body), a path from
+    across the midline back to its side (z +0.05 -> -0.11), an invalid plan, and a robot5's front
+    leg (its hip on the midline) are not."""
     from footfall.planner._crowd import paths_through_body
 
     def plans(creature_name, leg, bends):
@@ -535,7 +536,7 @@ def test_a_swing_path_under_the_body_waits():
         paths = []
         for z0, z1, bend in bends:
             z = z0 + (z1 - z0) * u + bend * np.sin(np.pi * u)
-            paths.append(np.stack([0.05 + 0.6 * u, np.zeros_like(u), z], axis=1))
+            paths.append(np.stack([-0.1 + 0.6 * u, np.zeros_like(u), z], axis=1))
         f = len(bends)
         return model, state, np.zeros(f, np.int64), np.full(f, leg), np.array(paths)
 
@@ -545,6 +546,8 @@ def test_a_swing_path_under_the_body_waits():
     assert paths[2, :, 2].max() == pytest.approx(0.19)
     assert paths_through_body(model, state, cs, ls, paths, valid).tolist() == [False, False, True, False]
     assert paths_through_body(model, state, cs, ls, paths, ~valid).tolist() == [False] * 4
+    behind = paths - np.array([0.8, 0.0, 0.0])
+    assert paths_through_body(model, state, cs, ls, behind, valid).tolist() == [False] * 4
     # The same paths for the left front leg (leg 0), and for leg 1 of the body turned a half turn (its
     # right side is then +z): the paths lie across the midline, and only the one bent out to z = -0.3
     # goes further across than its ends.
