@@ -312,6 +312,13 @@ class CrowdModel:
         n = self.n_legs
         return np.array([[j for j in range(n) if j != i] for i in range(n)], dtype=np.int64).reshape(n, n - 1)
 
+    @cached_property
+    def leg_sides(self) -> np.ndarray:
+        """(L,) each leg's side of the body's midline: +1 left, -1 right, 0 for a hip on the midline
+        (within 1e-3 rest radii: a robot5's front leg)."""
+        lateral = self.hips_body[:, 2]
+        return np.sign(lateral) * (np.abs(lateral) > 1e-3 * self.rest_radius)
+
     @property
     def rest_radius(self) -> float:
         return float(np.max(np.hypot(self.rest_body[:, 0], self.rest_body[:, 1])))
@@ -1120,12 +1127,10 @@ def leg_turn_bounds(model: CrowdModel, state: CrowdState, lift=None) -> np.ndarr
     give no bound. ``lift``: :func:`until_lift` of this state if the caller has it.
     """
     lift = until_lift(model, state) if lift is None else lift
-    side = np.sign(model.hips_body[:, 2]) * (np.abs(model.hips_body[:, 2]) > 1e-3 * model.rest_radius)
+    side = model.leg_sides
     margin = STANCE_SIDE_MARGIN * np.abs(model.hips_body[:, 2])
-    cos, sin = np.cos(state.heading)[:, None], np.sin(state.heading)[:, None]
     d = state.feet[:, :, [0, 2]] - state.pelvis[:, None, [0, 2]]
-    forward = d[..., 0] * cos + d[..., 1] * sin
-    lateral = -d[..., 0] * sin + d[..., 1] * cos
+    forward, lateral = _rot_xz(-state.heading[:, None], d[..., 0], d[..., 1])  # the feet in the body's frame
     # Turning by a moves the foot's lateral coordinate by about -forward * a (a small).
     room = np.maximum(side * lateral - margin, 0.0) * model.dt / lift
     lever = side * forward
@@ -1323,11 +1328,11 @@ def paths_through_body(model: CrowdModel, state: CrowdState, cs, ls, trajectorie
     one (``mixed``, 6 quadrupeds, seed 4009, frame 292). Such a plan waits a frame, as a conflicting
     one does (:func:`_same_frame_conflicts`). Legs on the midline (a robot5's front leg) have no side.
     A path starting (or ending) across, a foot coming back to its side, is not refused."""
-    side = np.sign(model.hips_body[ls, 2]) * (np.abs(model.hips_body[ls, 2]) > 1e-3 * model.rest_radius)
-    cos, sin = np.cos(state.heading[cs])[:, None], np.sin(state.heading[cs])[:, None]
+    side = model.leg_sides[ls]
     d = trajectories[:, :, [0, 2]] - state.pelvis[cs][:, None, [0, 2]]
-    own_side = side[:, None] * (-d[..., 0] * sin + d[..., 1] * cos)  # > 0: on the leg's own side
-    alongside = np.abs(d[..., 0] * cos + d[..., 1] * sin) <= 0.5 * model.creature.body_box[0]
+    forward, lateral = _rot_xz(-state.heading[cs][:, None], d[..., 0], d[..., 1])  # the path in the body's frame
+    own_side = side[:, None] * lateral  # > 0: on the leg's own side
+    alongside = np.abs(forward) <= 0.5 * model.creature.body_box[0]
     deepest = np.where(alongside, own_side, np.inf).min(axis=1)
     return valid & (side != 0.0) & (deepest < np.minimum(0.0, np.minimum(own_side[:, 0], own_side[:, -1])))
 
