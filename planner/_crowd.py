@@ -1334,7 +1334,8 @@ def paths_through_body(model: CrowdModel, state: CrowdState, cs, ls, trajectorie
     own_side = side[:, None] * lateral  # > 0: on the leg's own side
     alongside = np.abs(forward) <= 0.5 * model.creature.body_box[0]
     deepest = np.where(alongside, own_side, np.inf).min(axis=1)
-    return valid & (side != 0.0) & (deepest < np.minimum(0.0, np.minimum(own_side[:, 0], own_side[:, -1])))
+    # A leg on the midline (side 0) has own_side 0 everywhere, never below its ends: never refused.
+    return valid & (deepest < np.minimum(0.0, np.minimum(own_side[:, 0], own_side[:, -1])))
 
 
 def _same_frame_conflicts(model: CrowdModel, cs, targets, valid, hips=None) -> np.ndarray:

@@ -520,8 +520,8 @@ def test_a_swing_path_under_the_body_waits():
     """A plan whose path passes further across its body's midline than both its ends (a way under the
     body, between the hips) waits a frame (planner._crowd.paths_through_body). A quadruped at the
     origin facing +x (left is +z; its body box 0.6 m long): its right front leg (leg 1) from
-    (-0.1, -0.22) to (0.5, -0.11), straight, or bent out to z = -0.3, keeps to its side; bent to
-    z = +0.19 it is refused. The same bent path 0.8 m further back (behind the body), a path from
+    (-0.1, -0.22) to (0.5, -0.11), straight, bent out to z = -0.3, or bent in to z = -0.013, keeps to
+    its side; bent to z = +0.19 it is refused. The same bent path 0.8 m further back (behind the body), a path from
     across the midline back to its side (z +0.05 -> -0.11), an invalid plan, and a robot5's front
     leg (its hip on the midline) are not."""
     from footfall.planner._crowd import paths_through_body
@@ -540,23 +540,25 @@ def test_a_swing_path_under_the_body_waits():
         f = len(bends)
         return model, state, np.zeros(f, np.int64), np.full(f, leg), np.array(paths)
 
-    bends = [(-0.22, -0.11, 0.0), (-0.22, -0.11, -0.15), (-0.22, -0.11, 0.355), (0.05, -0.11, 0.0)]
+    # The fifth path bends toward the midline, to z = -0.013, and stays on the leg's side.
+    bends = [(-0.22, -0.11, 0.0), (-0.22, -0.11, -0.15), (-0.22, -0.11, 0.355), (0.05, -0.11, 0.0),
+             (-0.22, -0.11, 0.15)]
     model, state, cs, ls, paths = plans("quadruped", 1, bends)
-    valid = np.ones(4, np.bool_)
-    assert paths[2, :, 2].max() == pytest.approx(0.19)
-    assert paths_through_body(model, state, cs, ls, paths, valid).tolist() == [False, False, True, False]
-    assert paths_through_body(model, state, cs, ls, paths, ~valid).tolist() == [False] * 4
+    valid = np.ones(5, np.bool_)
+    assert paths[2, :, 2].max() == pytest.approx(0.19) and paths[4, :, 2].max() == pytest.approx(-0.0127, abs=1e-4)
+    assert paths_through_body(model, state, cs, ls, paths, valid).tolist() == [False, False, True, False, False]
+    assert paths_through_body(model, state, cs, ls, paths, ~valid).tolist() == [False] * 5
     behind = paths - np.array([0.8, 0.0, 0.0])
-    assert paths_through_body(model, state, cs, ls, behind, valid).tolist() == [False] * 4
+    assert paths_through_body(model, state, cs, ls, behind, valid).tolist() == [False] * 5
     # The same paths for the left front leg (leg 0), and for leg 1 of the body turned a half turn (its
     # right side is then +z): the paths lie across the midline, and only the one bent out to z = -0.3
     # goes further across than its ends.
-    assert paths_through_body(model, state, cs, np.zeros(4, np.int64), paths, valid).tolist() == [
-        False, True, False, False]
+    assert paths_through_body(model, state, cs, np.zeros(5, np.int64), paths, valid).tolist() == [
+        False, True, False, False, False]
     state.heading[0] = np.pi
-    assert paths_through_body(model, state, cs, ls, paths, valid).tolist() == [False, True, False, False]
+    assert paths_through_body(model, state, cs, ls, paths, valid).tolist() == [False, True, False, False, False]
     model, state, cs, ls, paths = plans("robot5", 0, bends)
-    assert paths_through_body(model, state, cs, ls, paths, valid).tolist() == [False] * 4
+    assert paths_through_body(model, state, cs, ls, paths, valid).tolist() == [False] * 5
 
 
 def test_the_quadruped_whose_front_leg_was_routed_under_its_body_keeps_its_legs_uncrossed():
