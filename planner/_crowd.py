@@ -380,6 +380,8 @@ class CrowdState:
     wants_swing: np.ndarray  # (C, L) bool: the gait asked for a swing not yet planned
     sector_missed: np.ndarray  # (C, L) bool: the needle entered the foot's sector while it was in the air
     stalled_s: np.ndarray  # (C,) s the body's legs (not a hold) have kept it at rest while it asks to walk
+    waited_s: np.ndarray  # (C,) s ORCA has held the character back for a walking neighbour (wait_for_others)
+    right_of_way_s: np.ndarray  # (C,) s left of the right of way a wait of WAIT_LIMIT_S earned (planner._kernels_avoidance)
     swing_t: np.ndarray
     swing_T: np.ndarray
     trajectories: np.ndarray  # (C, L, K, 3)
@@ -560,6 +562,7 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
     state.goal_speed = goal_speed
     preferred = direction * goal_speed[:, None]
     velocity, avoided, among_others, neighbours = _avoid(model, state, preferred, dist, boxes, box_velocity, in_lane)
+    wait_for_others(model, state, preferred, velocity, neighbours)
     # An escaper whose ORCA velocity heads somewhere worse than its way, looked ahead against the boxes,
     # follows its way where that keeps it clear of the others (planner._escape: ORCA's velocity is
     # holonomic; for a body that walks along its heading it flipped from ahead to behind as a crate closed in).
@@ -758,6 +761,62 @@ in a symmetric standstill (two characters exactly head-on), a shared convention 
 
 MOBILE_FRACTION = 0.25
 """x goal speed: a character slower than this cannot make way; its neighbours avoid it alone."""
+WAIT_LIMIT_S = 1.0
+"""s: a character ORCA has held back this long for a walking neighbour gets the right of way for
+RIGHT_OF_WAY_S (:func:`wait_for_others`)."""
+RIGHT_OF_WAY_S = 1.0
+"""s: how long a right of way lasts: its holder walks on, and its neighbours make way for it alone."""
+HELD_PROGRESS = 0.5
+"""x preferred speed: ORCA's velocity making less progress along the preferred one than this holds a
+character back (:func:`wait_for_others`). At MOBILE_FRACTION (0.25) the count kept restarting: a
+quadruped waiting for a neighbour to pass got 0.072-0.089 m/s of ORCA's velocity along its 0.3 m/s way
+while its body, turning, stood (``crates-moving``, seed 4009)."""
+
+
+def can_make_way(state: CrowdState) -> np.ndarray:
+    """(C,) bool: characters walking at MOBILE_FRACTION of their sustained speed or more, not held: the
+    ones ORCA lets share the effort of avoiding (a slower one walks off only along its heading and turns
+    slowly; its neighbours steer round it as round a box)."""
+    return (state.speed >= MOBILE_FRACTION * sustained_speed(state)) & ~state.body_held
+
+
+def wait_for_others(model: CrowdModel, state: CrowdState, preferred: np.ndarray, velocity: np.ndarray,
+                    neighbours) -> None:
+    """Count how long ORCA has held each character back for others to pass, and give the right of way
+    (``state.right_of_way_s``, read by the next frame's ORCA) to one that has waited WAIT_LIMIT_S.
+
+    Held back: standing aside (it cannot make way, :func:`can_make_way`), its ORCA velocity's progress
+    along the preferred one under HELD_PROGRESS of the preferred speed, while a neighbour within
+    NEAR_RADII avoid radii walks;
+    ``neighbours``: the CSR lists :func:`_avoid` returns. Why: a neighbour crossing its way and steering
+    round it as round a standing body orbits the waiting character's disc, and ORCA between them settles
+    on waiting until the neighbour has passed, which at 0.3 m/s round a 1 m disc took 2.5-3 s
+    (``crates-moving``, quadrupeds, bar seeds 3007, 4003, 4009: the stuck runs of the crowds issue's bar
+    sets). With the right of way the waiting one walks on and the neighbour steers round it alone;
+    :func:`bodies_apart` still refuses any step into a body. Only for one standing aside and only for
+    walking neighbours: granted to any character with another near and ORCA's progress under
+    MOBILE_FRACTION, it went to walkers in packs of ants and spiders that then jammed, and the stuck time of
+    the crowds of 16 and 64 on ``crates`` and ``mixed`` (seeds 1-3, 600 frames) rose 5.5 -> 13.3 s and
+    42.4 -> 83.1 s.
+    """
+    start, index = neighbours
+    n = state.pelvis.shape[0]
+    passing = np.zeros(n, np.bool_)
+    if index.size:
+        rows = np.repeat(np.arange(n), np.diff(start))
+        xz = state.pelvis[:, [0, 2]]
+        gap = np.hypot(*(xz[index] - xz[rows]).T)
+        walking = rows[(gap < NEAR_RADII * model.avoid_radius) & can_make_way(state)[index]]
+        passing[walking] = True
+    dt = model.dt
+    asked = np.hypot(preferred[:, 0], preferred[:, 1])
+    progress = (velocity * preferred).sum(axis=1) / np.maximum(asked, 1e-12)
+    held = passing & ~can_make_way(state) & (asked > 0.0) & (progress < HELD_PROGRESS * asked)
+    left = state.right_of_way_s - dt
+    state.right_of_way_s = np.where(left > 1e-9, left, 0.0)  # whole frames: no float residue left over
+    state.waited_s = np.where(held & (state.right_of_way_s <= 0.0), state.waited_s + dt, 0.0)
+    earned = state.waited_s >= WAIT_LIMIT_S - 1e-9
+    state.right_of_way_s[earned] = RIGHT_OF_WAY_S  # (its wait restarts from 0 after the right of way)
 
 LANE_HORIZON = 3.0
 """s: a moving box that will reach a character within this time makes it leave the box's lane."""
@@ -1020,14 +1079,14 @@ def _avoid(model: CrowdModel, state: CrowdState, preferred: np.ndarray, to_targe
     # and turns slowly, so the others steer round it as round a box (left half the effort, or given
     # way by it when escaping a box's lane, one walked into a spider standing in its path at 0.29 m/s:
     # 63 overlapping frames, mixed, seed 1121411189).
-    goal = sustained_speed(state)
-    mobile = (state.speed >= MOBILE_FRACTION * goal) & ~state.body_held
+    mobile = can_make_way(state)
     # ... and such a body, for its own velocity, keeps only part of its disc from those walking
     # (YIELD_RADIUS).
     out = np.empty((n, 2))
     orca_velocities(xz, np.ascontiguousarray(velocity), np.ascontiguousarray(preferred), np.full(n, radius),
                     np.full(n, top), start, index, *orca_boxes, AVOID_HORIZON, AVOID_BOX_HORIZON, model.dt,
-                    np.ascontiguousarray(escaping), mobile, np.full(n, YIELD_RADIUS * radius), out)
+                    np.ascontiguousarray(escaping), mobile, np.full(n, YIELD_RADIUS * radius), state.right_of_way_s > 0.0,
+                    out)
     avoided = np.hypot(*(out - preferred).T) > 1e-9
     return out, avoided, near, (start, index)
 
@@ -2481,7 +2540,8 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         t=0.0, frame=0, pelvis=pelvis, heading=headings.copy(), pitch=np.zeros(n), roll=np.zeros(n),
         speed=np.zeros(n), desired_speed=np.full(n, speed), route=routes, route_index=np.zeros(n, np.int64),
         feedback=np.zeros((n, 2)), feet=feet, in_stance=np.ones((n, L), np.bool_),
-        wants_swing=np.zeros((n, L), np.bool_), sector_missed=np.zeros((n, L), np.bool_), stalled_s=np.zeros(n), swing_t=np.zeros((n, L)), swing_T=np.zeros((n, L)),
+        wants_swing=np.zeros((n, L), np.bool_), sector_missed=np.zeros((n, L), np.bool_), stalled_s=np.zeros(n),
+        waited_s=np.zeros(n), right_of_way_s=np.zeros(n), swing_t=np.zeros((n, L)), swing_T=np.zeros((n, L)),
         trajectories=np.repeat(feet[:, :, None, :], K, axis=2), swing_target=feet.copy(),
         plan_heading=np.repeat(headings[:, None], L, axis=1), plan_speed=np.zeros((n, L)),
         feet_spacing=np.ones(n), plan_spacing=np.ones((n, L)), foot_yaws=yaws,

@@ -9,7 +9,10 @@ velocities of A are the half-plane through ``v_A + u / 2`` whose normal is ``u``
 avoid anyone: against a box A takes all of ``u``; the box is seen from A as its nearest point
 (a disc of radius 0 moving with the box), which for a convex box is exact where it matters (the
 nearest point is where a collision starts). A character already overlapping a neighbour or a
-box is pushed out within one time step.
+box is pushed out within one time step. A character that has waited too long for a neighbour to pass
+(the right of way, ``planner._crowd.wait_for_others``) leaves that neighbour's half-plane out, and the
+neighbour takes the whole effort: ORCA alone can hold a waiting character for seconds while a neighbour
+that steers round it orbits its disc.
 
 The new velocity is the one closest to the preferred velocity inside every half-plane and the
 disc of the character's top speed: an incremental 2-D linear program; where the half-planes
@@ -214,7 +217,7 @@ def _cone_line(px, py, vx, vy, r, tau, dt, share, ax, ay, out_point, out_dir, k)
 @nb.njit(cache=True, parallel=True)
 def orca_velocities(positions, velocities, preferred, radii, max_speed, neighbour_start, neighbour_index,
                     box_centres, box_half, box_yaws, box_velocities, box_active, box_pad, time_horizon,
-                    box_time_horizon, dt, priority, mobile, yield_radii, out):
+                    box_time_horizon, dt, priority, mobile, yield_radii, right_of_way, out):
     """New velocity (C, 2) of every character: closest to ``preferred`` among those that avoid
     every neighbour for ``time_horizon`` seconds (sharing the effort) and every active box for
     ``box_time_horizon`` seconds (alone), at most ``max_speed``.
@@ -229,7 +232,9 @@ def orca_velocities(positions, velocities, preferred, radii, max_speed, neighbou
     heading and turns slowly) is avoided by the other with its whole effort, as a box would be;
     ``yield_radii`` (C,) m: the radius such a character keeps, for its own velocity, from one that can
     make way (less than its disc, ``planner._crowd.YIELD_RADIUS``; the other still keeps the whole disc
-    round it, ``radii``).
+    round it, ``radii``); ``right_of_way`` (C,) bool: a character that has waited too long for others to pass
+    (``planner._crowd.WAIT_LIMIT_S``): between equals otherwise, the other takes the whole effort and it
+    leaves that other's half-plane out (it walks on; the other, walking, steers round it as round a box).
     """
     n = positions.shape[0]
     for c in nb.prange(n):
@@ -277,10 +282,14 @@ def orca_velocities(positions, velocities, preferred, radii, max_speed, neighbou
             combined = (yield_radii[c] if mobile[j] and not mobile[c] else ra) + radii[j]
             if not mobile[j]:
                 share = 1.0
-            elif priority[c] == priority[j]:
-                share = 0.5
-            else:
+            elif priority[c] != priority[j]:
                 share = 0.0 if priority[c] else 1.0
+            elif right_of_way[c] != right_of_way[j]:
+                if right_of_way[c]:
+                    continue  # j makes way alone (the branch below, from j's side)
+                share = 1.0
+            else:
+                share = 0.5
             _cone_line(positions[j, 0] - pax, positions[j, 1] - paz, vax - velocities[j, 0], vaz - velocities[j, 1],
                        combined, time_horizon, dt, share, vax, vaz, points, directions, k)
             k += 1

@@ -17,14 +17,15 @@ NO_BOXES = (np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), np.zeros((0, 2)), n
 
 
 def _step(pos, vel, pref, radii, vmax, boxes=NO_BOXES, tau=TAU, box_tau=1.0, priority=None, mobile=None,
-          yield_radii=None):
+          yield_radii=None, right_of_way=None):
     start, index = neighbour_lists(pos, 10.0)
     out = np.empty_like(pos)
     priority = np.zeros(len(pos), np.bool_) if priority is None else priority
     mobile = np.ones(len(pos), np.bool_) if mobile is None else mobile
     yield_radii = radii if yield_radii is None else yield_radii
+    right_of_way = np.zeros(len(pos), np.bool_) if right_of_way is None else right_of_way
     orca_velocities(pos, vel, pref, radii, vmax, start, index, *boxes, tau, box_tau, DT, priority, mobile, yield_radii,
-                    out)
+                    right_of_way, out)
     return out
 
 
@@ -95,6 +96,35 @@ def test_a_character_with_priority_keeps_its_way_and_the_other_takes_the_whole_e
     assert out[1] == pytest.approx([1.0 / 4.0, math.sqrt(3.0) / 4.0], abs=1e-12)
     out = _step(*args, priority=np.array([True, True]))
     assert out[0] == pytest.approx([7.0 / 8.0, -math.sqrt(3.0) / 8.0], abs=1e-12)
+
+
+def test_a_character_with_the_right_of_way_walks_on_and_the_other_takes_the_whole_effort():
+    # The case above, A asking a little faster, (1.2, 0): with priority its line still passes through
+    # v = (1, 0) along d = (-sqrt(3)/2, 1/2), and (1.2, 0) is on its forbidden side (det(d, (0.2, 0)) =
+    # -0.1): A gets its projection, (1, 0) + (0.2, 0).d d = (1.15, -sqrt(3)/20). With the right of way
+    # (a long wait, planner._crowd.wait_for_others) A leaves B's line out: (1.2, 0). B takes the whole
+    # -u either way, (1/4, sqrt(3)/4).
+    pos = np.array([[0.0, 0.0], [2.0, 0.0]])
+    vel = np.array([[1.0, 0.0], [0.0, 0.0]])
+    pref = np.array([[1.2, 0.0], [0.0, 0.0]])
+    args = (pos, vel, pref, np.array([0.5, 0.5]), np.array([2.0, 2.0]))
+    out = _step(*args, priority=np.array([True, False]))
+    assert out[0] == pytest.approx([1.15, -math.sqrt(3.0) / 20.0], abs=1e-12)
+    out = _step(*args, right_of_way=np.array([True, False]))
+    assert out[0] == pytest.approx([1.2, 0.0], abs=1e-12)
+    assert out[1] == pytest.approx([1.0 / 4.0, math.sqrt(3.0) / 4.0], abs=1e-12)
+    # Both with it: equals again (the half shares of the first case, A's line through (7/8, -sqrt(3)/8)
+    # along d, onto which (1.2, 0) projects at (7/8, -sqrt(3)/8) + ((1.2 - 7/8) (-sqrt(3)/2) + (sqrt(3)/8)(1/2)) d).
+    out = _step(*args, right_of_way=np.array([True, True]))
+    t = (1.2 - 7.0 / 8.0) * (-math.sqrt(3.0) / 2.0) + (math.sqrt(3.0) / 8.0) * 0.5
+    expected = np.array([7.0 / 8.0, -math.sqrt(3.0) / 8.0]) + t * np.array([-math.sqrt(3.0) / 2.0, 0.5])
+    assert out[0] == pytest.approx(expected, abs=1e-12)
+    # Priority (escaping a moving box) comes first: B escaping, A with the right of way, A takes it all,
+    # its line through v + u = (3/4, -sqrt(3)/4) along d; (1.2, 0) projects onto (3/4, -sqrt(3)/4) + s d.
+    out = _step(*args, priority=np.array([False, True]), right_of_way=np.array([True, False]))
+    s = (1.2 - 0.75) * (-math.sqrt(3.0) / 2.0) + (math.sqrt(3.0) / 4.0) * 0.5
+    expected = np.array([0.75, -math.sqrt(3.0) / 4.0]) + s * np.array([-math.sqrt(3.0) / 2.0, 0.5])
+    assert out[0] == pytest.approx(expected, abs=1e-12)
 
 
 def test_a_character_steers_round_one_that_cannot_make_way_with_its_whole_effort():

@@ -916,6 +916,75 @@ def test_a_body_its_legs_keep_at_rest_for_STALL_S_keeps_its_needle_turning():
     assert float(state.gaits.needle[0]) == needle
 
 
+def test_a_character_held_back_for_a_walking_neighbour_for_WAIT_LIMIT_S_gets_the_right_of_way():
+    # Character 0 stands (speed 0: it cannot make way) 0.3 m from character 1, who walks at its asked
+    # 0.3 m/s (avoid radius 0.1: NEAR_RADII of them is 0.4 m); ORCA gives 0 a velocity at right angles
+    # to its way (no progress), 1 its way. Held back for WAIT_LIMIT_S (30 frames at 30 Hz), 0 gets the
+    # right of way for RIGHT_OF_WAY_S (30 frames); the frame it runs out counts as the first of the next
+    # wait. 1, never held back, never gets it.
+    from types import SimpleNamespace
+
+    from footfall.planner import _crowd as crowd
+
+    model = SimpleNamespace(dt=1.0 / 30.0, avoid_radius=0.1)
+
+    def fresh():
+        return SimpleNamespace(waited_s=np.zeros(2), right_of_way_s=np.zeros(2),
+                               pelvis=np.array([[0.0, 0.1, 0.0], [0.3, 0.1, 0.0]]), speed=np.array([0.0, 0.3]),
+                               desired_speed=np.full(2, 0.3), speed_limit=np.full(2, np.inf),
+                               body_held=np.zeros(2, np.bool_))
+
+    neighbours = (np.array([0, 1, 2]), np.array([1, 0]))
+    preferred = np.array([[0.3, 0.0], [0.3, 0.0]])
+    velocity = np.array([[0.0, 0.3], [0.3, 0.0]])
+    wait = round(crowd.WAIT_LIMIT_S / model.dt)
+    hold = round(crowd.RIGHT_OF_WAY_S / model.dt)
+    expected = [False] * (wait - 1) + [True] * hold + [False] * (wait - 1) + [True]
+    state, granted = fresh(), []
+    for _ in expected:
+        crowd.wait_for_others(model, state, preferred, velocity, neighbours)
+        granted.append(bool(state.right_of_way_s[0] > 0.0))
+        assert state.right_of_way_s[1] == 0.0 and state.waited_s[1] == 0.0
+    assert granted == expected
+
+    def waited_after(**change):
+        """0's wait after two frames held back and one with ``change`` (to the state, or ``velocity``)."""
+        state = fresh()
+        crowd.wait_for_others(model, state, preferred, velocity, neighbours)
+        crowd.wait_for_others(model, state, preferred, velocity, neighbours)
+        v = change.pop("velocity", velocity)
+        for name, value in change.items():
+            setattr(state, name, value)
+        crowd.wait_for_others(model, state, preferred, v, neighbours)
+        return state.waited_s[0]
+
+    assert waited_after() == pytest.approx(3 * model.dt, abs=1e-12)
+    # HELD_PROGRESS of the way is progress enough: the wait starts again; just under it is not.
+    enough = crowd.HELD_PROGRESS * 0.3
+    assert waited_after(velocity=np.array([[enough, 0.2], [0.3, 0.0]])) == 0.0
+    assert waited_after(velocity=np.array([[0.99 * enough, 0.2], [0.3, 0.0]])) > 0.0
+    # 0 walking (it can make way itself), 1 standing (a jam, not a wait for one to pass), or 1 beyond
+    # NEAR_RADII avoid radii: no wait.
+    assert waited_after(speed=np.array([0.3, 0.3])) == 0.0
+    assert waited_after(speed=np.array([0.0, 0.0])) == 0.0
+    assert waited_after(pelvis=np.array([[0.0, 0.1, 0.0], [0.41, 0.1, 0.0]])) == 0.0
+    # The speed 0 must walk to make way is its sustained one: held to 0.1 m/s, 0.03 m/s is enough.
+    assert waited_after(speed=np.array([0.03, 0.3]), speed_limit=np.array([0.1, np.inf])) == 0.0
+
+
+def test_the_quadruped_a_neighbour_orbited_walks_on():
+    # crates-moving, 6 quadrupeds, seed 4003 (footfall evaluate's bar set, 2026-11-28): character 4 stood
+    # aside while neighbour 2, crossing its way at 0.3 m/s, steered round it as round a standing body,
+    # orbiting its 1.08 m disc for 2.7 s: ORCA held character 4 to 0.06-0.09 m/s, at right angles to its
+    # way (stuck 0.4 s). With the right of way after a second's wait it walks on.
+    from footfall.reports._evaluate import run_one
+
+    run = run_one({"scenario": "crates-moving", "creature": "quadruped", "seed": 4003, "characters": 6,
+                   "frames": 300, "lod": "off"})
+    assert run["violations"]["stuck"] == 0
+    assert run["violations"]["body_overlaps"] == 0
+
+
 def test_a_stance_foot_steps_out_of_turn_only_when_it_holds_the_body_under_half_the_asked_speed():
     """A stance foot whose leg cannot carry the body at half the speed asked steps now (a forced step);
     'asked' is what the steering asks (a turn or a neighbour may ask less than the goal), never taken
