@@ -773,6 +773,16 @@ quadruped waiting for a neighbour to pass got 0.072-0.089 m/s of ORCA's velocity
 while its body, turning, stood (``crates-moving``, seed 4009)."""
 
 
+def near_pairs(model: CrowdModel, state: CrowdState, neighbours) -> tuple[np.ndarray, np.ndarray]:
+    """(rows, cols): the pairs (character, neighbour) of the CSR ``neighbours`` lists (:func:`_avoid`)
+    within NEAR_RADII avoid radii of each other."""
+    start, index = neighbours
+    rows = np.repeat(np.arange(state.pelvis.shape[0]), np.diff(start))
+    xz = state.pelvis[:, [0, 2]]
+    close = np.hypot(*(xz[index] - xz[rows]).T) < NEAR_RADII * model.avoid_radius
+    return rows[close], index[close]
+
+
 def can_make_way(state: CrowdState) -> np.ndarray:
     """(C,) bool: characters walking at MOBILE_FRACTION of their sustained speed or more, not held: the
     ones ORCA lets share the effort of avoiding (a slower one walks off only along its heading and turns
@@ -799,19 +809,14 @@ def wait_for_others(model: CrowdModel, state: CrowdState, preferred: np.ndarray,
     the crowds of 16 and 64 on ``crates`` and ``mixed`` (seeds 1-3, 600 frames) rose 5.5 -> 13.3 s and
     42.4 -> 83.1 s.
     """
-    start, index = neighbours
-    n = state.pelvis.shape[0]
-    passing = np.zeros(n, np.bool_)
-    if index.size:
-        rows = np.repeat(np.arange(n), np.diff(start))
-        xz = state.pelvis[:, [0, 2]]
-        gap = np.hypot(*(xz[index] - xz[rows]).T)
-        walking = rows[(gap < NEAR_RADII * model.avoid_radius) & can_make_way(state)[index]]
-        passing[walking] = True
+    mobile = can_make_way(state)
+    rows, cols = near_pairs(model, state, neighbours)
+    passing = np.zeros(state.pelvis.shape[0], np.bool_)
+    passing[rows[mobile[cols]]] = True
     dt = model.dt
     asked = np.hypot(preferred[:, 0], preferred[:, 1])
     progress = (velocity * preferred).sum(axis=1) / np.maximum(asked, 1e-12)
-    held = passing & ~can_make_way(state) & (asked > 0.0) & (progress < HELD_PROGRESS * asked)
+    held = passing & ~mobile & (asked > 0.0) & (progress < HELD_PROGRESS * asked)
     left = state.right_of_way_s - dt
     state.right_of_way_s = np.where(left > 1e-9, left, 0.0)  # whole frames: no float residue left over
     state.waited_s = np.where(held & (state.right_of_way_s <= 0.0), state.waited_s + dt, 0.0)
@@ -1058,10 +1063,7 @@ def _avoid(model: CrowdModel, state: CrowdState, preferred: np.ndarray, to_targe
     start, index = neighbour_lists(xz, max(2.0 * radius + 2.0 * top * AVOID_HORIZON, NEAR_RADII * radius),
                                    AVOID_NEIGHBOURS)
     near = np.zeros(n, np.bool_)
-    if index.size:
-        rows = np.repeat(np.arange(n), np.diff(start))
-        gap = np.hypot(*(xz[index] - xz[rows]).T)
-        near[rows[gap < NEAR_RADII * radius]] = True
+    near[near_pairs(model, state, (start, index))[0]] = True
     if near.any():
         c, s = math.cos(KEEP_RIGHT), math.sin(-KEEP_RIGHT)
         turn = near & (to_target > 1.0)
