@@ -88,6 +88,35 @@ def swings_invalidated(in_stance, swing_t, swing_T, trajectories, foot_hx, foot_
                     break
 
 
+@nb.njit(cache=True, parallel=True)
+def swings_meet_moving_boxes(trajectories, swing_t, swing_T, dt, foot_hx, foot_hz, foot_yaws, frame_centres,
+                             frame_yaws, box_sizes, box_forbidden, box_moving, out):
+    """Swings (``trajectories`` (F, K, 3), at ``swing_t`` of ``swing_T`` s) whose foot, where
+    :func:`advance_swings` puts it on each of the frames to come, overlaps a moving box where that box is
+    then: ``frame_centres`` (J, B, 3), ``frame_yaws`` (J, B), the boxes 1..J frames from now. A path
+    clear of the boxes' cells now can still graze one: a cell free of a box holds points a millimetre
+    from it, the foot is not a point, and the box moves on during the swing. Into ``out`` (F,) bool."""
+    n, k, _ = trajectories.shape
+    n_frames = frame_centres.shape[0]
+    for f in nb.prange(n):
+        out[f] = False
+        for j in range(1, n_frames + 1):
+            u = (swing_t[f] + j * dt) / swing_T[f] if swing_T[f] > 0 else 1.0
+            u = min(u, 1.0)
+            s = u * (k - 1)
+            i = min(int(s), k - 2)
+            a = s - i
+            x = trajectories[f, i, 0] + a * (trajectories[f, i + 1, 0] - trajectories[f, i, 0])
+            y = trajectories[f, i, 1] + a * (trajectories[f, i + 1, 1] - trajectories[f, i, 1])
+            z = trajectories[f, i, 2] + a * (trajectories[f, i + 1, 2] - trajectories[f, i, 2])
+            if foot_box_conflict(x, y, z, foot_hx, foot_hz, foot_yaws[f], 0.0, frame_centres[j - 1], box_sizes,
+                                 frame_yaws[j - 1], box_forbidden, box_moving):
+                out[f] = True
+                break
+            if u >= 1.0:
+                break
+
+
 @nb.njit(cache=True)
 def points_in_boxes(points, foot_hx, foot_hz, foot_yaws, box_centres, box_sizes, box_yaws, box_forbidden, out):
     """Feet (a foot's box of half extents ``foot_hx``, ``foot_hz`` at each of ``points`` (F, 3), turned by

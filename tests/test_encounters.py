@@ -846,3 +846,52 @@ def test_a_moving_box_that_reaches_a_foot_in_the_air_shoves_the_body_and_its_fee
     np.testing.assert_array_equal(state.feet[0, 1:], before[1][0, 1:])  # the stance feet stay
     # The foot in the air now keeps exactly the margin from the crate's face.
     assert (0.15 + 0.005) - (0.15 + push[0]) == pytest.approx(need, abs=1e-12)
+
+
+def test_a_swing_meets_a_moving_box_only_where_the_box_is_when_the_foot_gets_there():
+    # A straight swing along x from 0 to 0.4 m on 5 samples, 0.4 s long, frames of 0.1 s: the foot is
+    # at x = 0.1, 0.2, 0.3, 0.4 on the frames to come (advance_swings moves it at constant speed). A
+    # 0.1 m box (forbidden: every height) whose near face is 5 mm from the swing's line overlaps the
+    # 2 cm foot only where the foot is beside it on that frame.
+    from footfall.planner._kernels_controller import swings_meet_moving_boxes
+
+    path = np.zeros((1, 5, 3))
+    path[0, :, 0] = np.linspace(0.0, 0.4, 5)
+    far = np.array([9.0, 0.0, 9.0])
+
+    def meets(box_on_frame, swing_t=0.0, moving=True):
+        """The box at ``box_on_frame[j]`` (x) on frame j + 1 (far away when None)."""
+        centres = np.array([[[far if x is None else [x, 0.0, 0.055]][0]] for x in box_on_frame], dtype=float)
+        out = np.zeros(1, np.bool_)
+        swings_meet_moving_boxes(path, np.array([swing_t]), np.array([0.4]), 0.1, 0.01, 0.01, np.zeros(1),
+                                 centres, np.zeros((len(box_on_frame), 1)), np.array([[0.1, 1.0, 0.1]]),
+                                 np.ones(1, np.bool_), np.array([moving]), out)
+        return bool(out[0])
+
+    assert meets([None, 0.2, None, None])  # beside the foot on frame 2, when the foot is at x = 0.2
+    assert not meets([None, None, 0.2, None])  # there on frame 3: the foot is at 0.3, 4 cm past its face
+    assert not meets([0.2, None, None, None])  # there on frame 1: the foot is at 0.1, 4 cm short of it
+    assert meets([None, None, None, 0.4])  # on the landing spot when the foot lands
+    assert not meets([None, 0.2, None, None], moving=False)  # static boxes are the maps' business
+    # Half way through (swing_t 0.2 s) the frames to come put the foot at 0.3 and then 0.4.
+    assert meets([0.3, None], swing_t=0.2)
+    assert not meets([0.1, None], swing_t=0.2)
+    assert not meets([None, 0.3], swing_t=0.2)
+
+
+def test_a_tucked_foot_beside_a_moving_crate_never_swings_into_it():
+    # 64 ants on mixed, seed 1: a tucked foot beside a crate moving at 0.34 m/s was re-planned on a path
+    # a millimetre from the crate, and the next re-plan ran it in (frames 452-453, character 57).
+    from footfall.scenarios._gait_choice import resolve_gait
+
+    scenario, creature = load_scenario("mixed"), load_creature("ant")
+    gait, _, _ = resolve_gait(None, creature)
+    model, state = init_crowd(scenario, creature, gait, n_characters=64, seed=1)
+    counters = FrameCounters(model, state)
+    in_boxes = []
+    for _ in range(470):
+        before = counters.collisions
+        step(model, state)
+        counters.update(state)
+        in_boxes.append(counters.collisions - before)
+    assert sum(in_boxes) == 0, [f for f, n in enumerate(in_boxes) if n]
