@@ -119,16 +119,39 @@ def test_a_crate_crossing_a_planned_swing_replans_it_the_same_frame(tmp_path, mo
     # against where a crate will be threat_horizon later too, so only a fast, narrow one gets between
     # those two poses onto a planned swing: this one must.) The body's avoidance (ORCA) is switched off
     # here: it keeps the feet clear of even this crate by waiting, and this test is about the swings.
+    # So is the check of a new swing against where the crate will be on each of its frames
+    # (swings_into_moving_boxes): with it no planned swing is ever crossed here (below).
     import footfall.planner._crowd as crowd
 
     monkeypatch.setattr(crowd, "_avoid", lambda model, state, preferred, *_: (
         preferred, np.zeros(preferred.shape[0], np.bool_), np.zeros(preferred.shape[0], np.bool_),
         (np.zeros(preferred.shape[0] + 1, np.int64), np.zeros(0, np.int64))))
+    checked = crowd.swings_into_moving_boxes
+    monkeypatch.setattr(crowd, "swings_into_moving_boxes", lambda *args: np.zeros(args[2].size, np.bool_))
+    invalidated, blocked, counters, state = _crossing_swings(tmp_path, monkeypatch)
+    assert sum(invalidated) > 0, "the crate must cross a planned swing"
+    assert state.counters["replans"] >= sum(invalidated) > 0
+    assert sum(blocked) == 0
+    assert counters.collisions == 0
+    assert state.pelvis[0, 0] > 2.0, "the spider walks on past the crate's path"
+    # With the check, every swing is planned clear of where the crate will be: none is crossed.
+    monkeypatch.setattr(crowd, "swings_into_moving_boxes", checked)
+    invalidated, blocked, counters, state = _crossing_swings(tmp_path, monkeypatch)
+    assert sum(invalidated) == 0 and sum(blocked) == 0 and counters.collisions == 0
+    assert state.pelvis[0, 0] > 2.0, "the spider walks on past the crate's path"
+
+
+def _crossing_swings(tmp_path, monkeypatch):
+    """The run of :func:`test_a_crate_crossing_a_planned_swing_replans_it_the_same_frame`: (swings the
+    runtime found invalidated per frame, swings left running through the crate after each frame, the
+    run's counters, its final state)."""
+    import footfall.planner._crowd as crowd
 
     model, state = _world(tmp_path, "across-swing", crate_centre=(-1.1, -4.0), crate_width=0.2, start=(-2.0, 0.0),
                           goal=(4.0, 0.0), velocity=(0.0, 2.0))
+    from footfall.planner._kernels_controller import swings_invalidated as runtime_check
+
     invalidated = []
-    runtime_check = crowd.swings_invalidated
 
     def counted(*args):  # the runtime's own check, counted (its last argument is its output)
         runtime_check(*args)
@@ -148,11 +171,7 @@ def test_a_crate_crossing_a_planned_swing_replans_it_the_same_frame(tmp_path, mo
             blocked.append(int(_inside(rest[low][:, [0, 2]], c, h, y).any()))
 
     counters = _run(model, state, 600, check)
-    assert sum(invalidated) > 0, "the crate must cross a planned swing"
-    assert state.counters["replans"] >= sum(invalidated) > 0
-    assert sum(blocked) == 0
-    assert counters.collisions == 0
-    assert state.pelvis[0, 0] > 2.0, "the spider walks on past the crate's path"
+    return invalidated, blocked, counters, state
 
 
 def _crate_from_behind(tmp_path, name, speed, width):
