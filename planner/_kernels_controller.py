@@ -34,6 +34,18 @@ def foot_box_conflict(x, y, z, foot_hx, foot_hz, foot_yaw, margin, box_centres, 
     return False
 
 
+@nb.njit(cache=True, inline="always")
+def swing_point(path, u, d):
+    """Coordinate ``d`` of a swinging foot at fraction ``u`` (0..1) of its swing along ``path`` (K, 3): its
+    samples are passed at a constant pace (the one definition :func:`advance_swings` moves feet by and
+    :func:`swings_meet_moving_boxes` follows them by)."""
+    k = path.shape[0]
+    s = u * (k - 1)
+    j = min(int(s), k - 2)
+    a = s - j
+    return path[j, d] + a * (path[j + 1, d] - path[j, d])
+
+
 @nb.njit(cache=True, parallel=True)
 def advance_swings(swing_t, swing_T, trajectories, in_stance, feet, dt, out_landed):
     """Move every swinging foot along its trajectory at constant speed; flag landings."""
@@ -50,11 +62,8 @@ def advance_swings(swing_t, swing_T, trajectories, in_stance, feet, dt, out_land
                     feet[c, i, d] = trajectories[c, i, k - 1, d]
                 out_landed[c, i] = True
                 continue
-            s = u * (k - 1)
-            j = min(int(s), k - 2)
-            a = s - j
             for d in range(3):
-                feet[c, i, d] = trajectories[c, i, j, d] + a * (trajectories[c, i, j + 1, d] - trajectories[c, i, j, d])
+                feet[c, i, d] = swing_point(trajectories[c, i], u, d)
 
 
 @nb.njit(cache=True, parallel=True)
@@ -96,19 +105,16 @@ def swings_meet_moving_boxes(trajectories, swing_t, swing_T, dt, foot_hx, foot_h
     then: ``frame_centres`` (J, B, 3), ``frame_yaws`` (J, B), the boxes 1..J frames from now. A path
     clear of the boxes' cells now can still graze one: a cell free of a box holds points a millimetre
     from it, the foot is not a point, and the box moves on during the swing. Into ``out`` (F,) bool."""
-    n, k, _ = trajectories.shape
+    n = trajectories.shape[0]
     n_frames = frame_centres.shape[0]
     for f in nb.prange(n):
         out[f] = False
         for j in range(1, n_frames + 1):
             u = (swing_t[f] + j * dt) / swing_T[f] if swing_T[f] > 0 else 1.0
             u = min(u, 1.0)
-            s = u * (k - 1)
-            i = min(int(s), k - 2)
-            a = s - i
-            x = trajectories[f, i, 0] + a * (trajectories[f, i + 1, 0] - trajectories[f, i, 0])
-            y = trajectories[f, i, 1] + a * (trajectories[f, i + 1, 1] - trajectories[f, i, 1])
-            z = trajectories[f, i, 2] + a * (trajectories[f, i + 1, 2] - trajectories[f, i, 2])
+            x = swing_point(trajectories[f], u, 0)
+            y = swing_point(trajectories[f], u, 1)
+            z = swing_point(trajectories[f], u, 2)
             if foot_box_conflict(x, y, z, foot_hx, foot_hz, foot_yaws[f], 0.0, frame_centres[j - 1], box_sizes,
                                  frame_yaws[j - 1], box_forbidden, box_moving):
                 out[f] = True
