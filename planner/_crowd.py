@@ -1413,17 +1413,16 @@ def swings_into_moving_boxes(model: CrowdModel, state: CrowdState, cs, ls, traje
         return out
     idx = np.flatnonzero(check)
     n_frames = max(1, int(math.ceil(float(np.max(swing_T[idx] - swing_t[idx])) / model.dt - 1e-9)))
-    poses = [obs.poses_at(state.t + j * model.dt) for j in range(1, n_frames + 1)]
-    centres = np.ascontiguousarray(np.stack([p[0] for p in poses]), dtype=np.float64)
-    yaws = np.ascontiguousarray(np.stack([p[1] for p in poses]), dtype=np.float64)
+    ahead = [_boxes_now(model, state.t + j * model.dt) for j in range(1, n_frames + 1)]
+    centres = np.stack([b[0] for b in ahead])
+    yaws = np.stack([b[2] for b in ahead])
+    _, sizes, _, forbidden, moving = ahead[0]
     hit = np.zeros(idx.size, dtype=np.bool_)
     swings_meet_moving_boxes(np.ascontiguousarray(trajectories[idx]), np.ascontiguousarray(swing_t[idx], dtype=np.float64),
                              np.ascontiguousarray(swing_T[idx], dtype=np.float64), model.dt,
                              0.5 * model.creature.foot_length, 0.5 * model.creature.foot_width,
-                             np.ascontiguousarray(state.foot_yaws[cs[idx], ls[idx]]), centres, yaws,
-                             np.ascontiguousarray(obs.sizes, dtype=np.float64),
-                             np.ascontiguousarray(obs.forbidden, dtype=np.bool_),
-                             np.ascontiguousarray(~np.asarray(obs.is_static), dtype=np.bool_), hit)
+                             np.ascontiguousarray(state.foot_yaws[cs[idx], ls[idx]]), centres, yaws, sizes, forbidden,
+                             moving, hit)
     out[idx] = hit
     return out
 
