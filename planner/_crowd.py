@@ -1401,10 +1401,11 @@ def paths_through_body(model: CrowdModel, state: CrowdState, cs, ls, trajectorie
 
 
 def swings_into_moving_boxes(model: CrowdModel, state: CrowdState, cs, ls, trajectories, swing_t, swing_T,
-                             check) -> np.ndarray:
+                             check, foot_yaws) -> np.ndarray:
     """(F,) bool: of the swings ``check`` of legs (``cs``, ``ls``) along ``trajectories`` (F, K, 3), at
-    ``swing_t`` of ``swing_T`` s, those whose foot meets a moving box on one of the frames to come, the
-    box where it is then (:func:`swings_meet_moving_boxes`). A tucked ant's re-plan beside a crate moving
+    ``swing_t`` of ``swing_T`` s, those whose foot (turned by ``foot_yaws`` (F,), the yaw it swings
+    with) meets a moving box on one of the frames to come, the box where it is then
+    (:func:`swings_meet_moving_boxes`). A tucked ant's re-plan beside a crate moving
     at 0.34 m/s ran its foot 1 mm from the crate, and the next one into it (``mixed``, 64 ants, seed 1,
     frames 452-453): the map's cells are free of the crate, the points in them need not be."""
     out = np.zeros(cs.size, dtype=np.bool_)
@@ -1421,7 +1422,7 @@ def swings_into_moving_boxes(model: CrowdModel, state: CrowdState, cs, ls, traje
     swings_meet_moving_boxes(np.ascontiguousarray(trajectories[idx]), np.ascontiguousarray(swing_t[idx], dtype=np.float64),
                              np.ascontiguousarray(swing_T[idx], dtype=np.float64), model.dt,
                              0.5 * model.creature.foot_length, 0.5 * model.creature.foot_width,
-                             np.ascontiguousarray(state.foot_yaws[cs[idx], ls[idx]]), centres, yaws, sizes, forbidden,
+                             np.ascontiguousarray(foot_yaws[idx], dtype=np.float64), centres, yaws, sizes, forbidden,
                              moving, hit)
     out[idx] = hit
     return out
@@ -1922,9 +1923,11 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     ok &= ~paths_through_body(model, state, cs, ls, out.trajectory, ok)
     # A swing that meets a moving box on the way waits a frame (the box moves on); a foot whose swing
     # already does, its re-plan refused, is tucked (it went on into the box).
-    ok &= ~swings_into_moving_boxes(model, state, cs, ls, out.trajectory, np.zeros(f), t_swing, ok)
+    # A new swing turns the foot to its plan's yaw (assigned below), a current one keeps its own.
+    ok &= ~swings_into_moving_boxes(model, state, cs, ls, out.trajectory, np.zeros(f), t_swing, ok, foot_yaw)
     meets = swings_into_moving_boxes(model, state, cs, ls, state.trajectories[cs, ls], state.swing_t[cs, ls],
-                                     state.swing_T[cs, ls], ~ok & ~new & ~state.in_stance[cs, ls])
+                                     state.swing_T[cs, ls], ~ok & ~new & ~state.in_stance[cs, ls],
+                                     state.foot_yaws[cs, ls])
     vc, vl = cs[ok], ls[ok]
     state.trajectories[vc, vl] = out.trajectory[ok]
     state.swing_t[vc, vl] = 0.0
