@@ -17,6 +17,7 @@ from footfall.scenarios._files import (
     load_creature,
     load_creature_text,
     load_scenario,
+    split_scenario_list,
     split_variant,
     variant_name,
 )
@@ -68,6 +69,7 @@ __all__ = [
     "load_creature_text",
     "load_gait",
     "load_scenario",
+    "split_scenario_list",
     "split_variant",
     "variant_name",
     "min_stance_feet",

@@ -436,6 +436,28 @@ def _split_top_level(text: str) -> list[str]:
     return items
 
 
+def split_scenario_list(text: str) -> tuple[str, ...]:
+    """``"A,B,..."`` (a command line's list of scenarios) -> its scenarios, a variant's overrides kept
+    with it: an item ``key=value`` with no ``@`` before its ``=`` continues the variant before it.
+
+    Examples
+    --------
+    >>> from footfall.scenarios import split_scenario_list
+    >>> split_scenario_list("stairs,hills@terrain.octaves=3,terrain.wavelength=1.2,crates@seed=13")
+    ('stairs', 'hills@terrain.octaves=3,terrain.wavelength=1.2', 'crates@seed=13')
+    >>> split_scenario_list("stairs@crowd.centre=[-3.0,0.0], mixed")
+    ('stairs@crowd.centre=[-3.0,0.0]', 'mixed')
+    """
+    names: list[str] = []
+    for item in (part.strip() for part in _split_top_level(text)):
+        continues = "=" in item and "@" not in item.partition("=")[0]
+        if continues and names and "@" in names[-1]:
+            names[-1] = f"{names[-1]},{item}"
+        elif item:
+            names.append(item)
+    return tuple(names)
+
+
 def variant_name(name: str, **overrides: Any) -> str:
     """The variant string of ``name`` with ``overrides`` (dotted keys as keyword names with ``__``
     for dots: ``variant_name("hills", seed=3, crowd__speed=0.1)``); floats written exactly.

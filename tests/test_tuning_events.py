@@ -95,7 +95,11 @@ def test_cli_refuses_a_malformed_targets_file_with_one_line_and_exit_2(tmp_path)
     bad = _write(tmp_path, "schema_version = 1\n[style]\nmax_touchdown_slope_rad = 9\n")
     for args, field in (([f"--targets={bad}"], "style.max_touchdown_slope_rad"),
                         ([f"--targets={tmp_path / 'none.toml'}"], "targets"),
-                        (["--scenarios=stairs,nowhere"], "scenario")):
+                        (["--scenarios=stairs,nowhere"], "scenario"),
+                        # a variant's overrides stay with it: the second one is checked as hills'
+                        # (read as a scenario of its own, it was "terrain.wavelength=-1: scenario: unknown")
+                        (["--scenarios=hills@terrain.octaves=3,terrain.wavelength=-1,stairs"],
+                         "hills@terrain.octaves=3,terrain.wavelength=-1: terrain.wavelength: must be > 0")):
         proc = footfall_cli("tune", "--creature", "spider", *args, "--out", tmp_path / "p.json", cwd=ROOT)
         assert proc.returncode == 2, proc.stderr
         assert field in proc.stderr and len(proc.stderr.strip().splitlines()) == 1, proc.stderr
