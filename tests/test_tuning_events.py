@@ -432,3 +432,23 @@ def test_the_events_checkpoint_round_trips_and_names_a_broken_field(tmp_path):
     broken = {k: v for k, v in data.items() if k != "default_exact"}
     with pytest.raises(InputError, match="default_exact: corrupt checkpoint: missing field"):
         EventTuneCheckpoint.from_json(broken, tmp_path / "e.json")
+
+
+def test_the_touchdown_slope_is_the_grounds_whatever_the_weights():
+    """The touch-down slope is read on the terrain under the landed feet. Read back from the plans'
+    goodnesses, x = (1 - s) slope_critical_rad, it was capped at the run's own critical value: a preset
+    that lowered it 1.0 -> 0.32 cut its own metric 0.058 -> 0.036 rad on rough ground while its feet
+    stood on ground as steep as the defaults' (session 48)."""
+    from footfall.planner._weights import ScoringWeights
+    from footfall.tuning._events import EventSetup, event_tasks, run_event_task
+    from footfall.tuning._matrix import ROUGH_GROUND
+    from footfall.tuning._targets import load_tune_targets
+
+    targets = load_tune_targets(None, "spider")
+    setup = EventSetup("spider", (ROUGH_GROUND,), seeds=(1,), frames=90, spawn_fractions=(0.3,))
+    critical = 0.02
+    task = event_tasks(setup, ScoringWeights(slope_critical_rad=critical), targets.timing())[0]
+    m = run_event_task(task)["metrics"]
+    # The defaults' touch-downs there stand on 0.07-0.09 rad; a capped reading could not exceed 0.02.
+    assert m["touchdown_slope_rad"] > 2.0 * critical, m["touchdown_slope_rad"]
+    assert 0.0 < m["touchdown_roughness_m"] < 0.05
