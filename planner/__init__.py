@@ -24,6 +24,7 @@ from footfall.planner._crowd import (  # noqa: E402
     step,
     sustained_speed,
 )
+from footfall.planner._footing import ground_under_feet  # noqa: E402
 from footfall.planner._gait import GaitManagerState, advance, init_gaits, set_destination, set_speed  # noqa: E402
 from footfall.planner._grid import GridFrame  # noqa: E402
 from footfall.planner._harvest import (  # noqa: E402
@@ -123,6 +124,7 @@ __all__ = [
     "GaitTiming",
     "GridFrame",
     "Harvest",
+    "ground_under_feet",
     "harvest_foot",
     "harvest_run",
     "hip_height",

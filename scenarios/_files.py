@@ -440,6 +440,16 @@ def split_scenario_list(text: str) -> tuple[str, ...]:
     """``"A,B,..."`` (a command line's list of scenarios) -> its scenarios, a variant's overrides kept
     with it: an item ``key=value`` with no ``@`` before its ``=`` continues the variant before it.
 
+    Parameters
+    ----------
+    text : str
+        Built-in names, files and variants (:func:`split_variant`), separated by commas.
+
+    Returns
+    -------
+    tuple of str
+        One entry per scenario, stripped; empty items dropped.
+
     Examples
     --------
     >>> from footfall.scenarios import split_scenario_list

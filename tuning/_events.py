@@ -27,8 +27,8 @@ Per run (:data:`EVENT_METRICS`):
 * ``leg_crossings``: the summary's crossing frames (not in the run loss; the preset matrix's guard);
 * ``curvature_p95``: 95th percentile of the plans' raw curvature energy (``RAW_CURVATURE``);
 * ``touchdown_slope_rad``, ``touchdown_roughness_m``: mean over the touch-downs of the ground's slope
-  and roughness under the foot (:func:`ground_under_feet`: the planner's footprint features, read on
-  the terrain where the foot landed at the planner's cell spacing). Whatever the weights: read back
+  and roughness under the foot (:func:`planner.ground_under_feet`: the planner's footprint features,
+  read on the terrain where the foot landed at the planner's cell spacing). Whatever the weights: read back
   from the plans' goodnesses (x = (1 - s) critical, capped at the critical value), a preset that
   lowered ``slope_critical_rad`` 1.0 -> 0.32 lowered its own metric 0.058 -> 0.036 rad on rough
   ground while its feet landed on ground as steep as the defaults' (0.0741 against 0.0747 rad);
@@ -171,36 +171,6 @@ def replay_command(task: dict, preset: str = "PRESET.json") -> str:
             f"--frames {task['frames']} --preset {preset} --json")
 
 
-def ground_under_feet(terrain, feet_xz: np.ndarray, spacing: float) -> tuple[np.ndarray, np.ndarray]:
-    """((n,) slope rad, (n,) roughness m) of the ground under feet ``feet_xz`` (n, 2): the planner's
-    footprint features (``planner._kernels_foot.footprint_features``: the slope from one-sided
-    differences through the slope limiter, the roughness as the largest height step to the 8
-    neighbours), read on the terrain's heights at ``spacing`` (m) around each foot.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from footfall.scenarios import Heightfield
-    >>> ramp = Heightfield(np.tile(0.5 * np.arange(5.0), (5, 1)), origin_x=0.0, origin_z=0.0, cell_size=1.0)
-    >>> slope, rough = ground_under_feet(ramp, np.array([[2.0, 2.0]]), 1.0)
-    >>> round(float(slope[0]), 4), float(rough[0])      # atan(0.5); a step of 0.5 m to the x neighbours
-    (0.4636, 0.5)
-    """
-    from footfall.planner._kernels_foot import _minmod
-
-    x, z = feet_xz[:, 0], feet_xz[:, 1]
-    d = np.array([-spacing, 0.0, spacing])
-    h = terrain.height_at(x[:, None, None] + d[None, None, :], z[:, None, None] + d[None, :, None])  # (n, z, x)
-    centre = h[:, 1, 1]
-    slope = np.empty(x.size)
-    for i in range(x.size):
-        gx = _minmod(h[i, 1, 2] - centre[i], centre[i] - h[i, 1, 0]) / spacing
-        gz = _minmod(h[i, 2, 1] - centre[i], centre[i] - h[i, 0, 1]) / spacing
-        slope[i] = math.atan(math.hypot(gx, gz))
-    rough = np.abs(h - centre[:, None, None]).reshape(x.size, 9).max(axis=1)
-    return slope, rough
-
-
 def run_event_task(task: dict) -> dict:
     """One run of :func:`event_tasks`: the simulation's summary and the plan metrics (picklable)."""
     from footfall.scenarios._gait_choice import resolve_gait
@@ -209,6 +179,7 @@ def run_event_task(task: dict) -> dict:
         ScoringWeights,
         arrived,
         asked_speed,
+        ground_under_feet,
         hip_height,
         init_crowd,
         simulate,

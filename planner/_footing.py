@@ -1,0 +1,57 @@
+"""The ground under the feet: the planner's footprint features (slope, roughness) read on the terrain
+where feet stand, whatever the scoring weights (a measure of where feet landed, for the tuning's
+touch-down metrics)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from footfall.planner._kernels_foot import _minmod
+
+
+def ground_under_feet(terrain, feet_xz: np.ndarray, spacing: float) -> tuple[np.ndarray, np.ndarray]:
+    """The slope and roughness of the ground under feet: the planner's footprint features
+    (``planner._kernels_foot.footprint_features``: the slope from one-sided differences through the
+    slope limiter, the roughness as the largest height step to the 8 neighbours) read on the terrain's
+    heights at ``spacing`` around each foot.
+
+    Parameters
+    ----------
+    terrain : object with ``height_at(x, z)``
+        The ground (a :class:`footfall.scenarios.Heightfield`): heights (m) at world points, broadcast.
+    feet_xz : (n, 2) array
+        The feet's ground positions x, z (m).
+    spacing : float
+        The neighbours' distance (m); the planner's cell size reads the ground as the planner does.
+
+    Returns
+    -------
+    slope : (n,) array
+        The ground's slope under each foot (rad).
+    roughness : (n,) array
+        The largest height difference (m) from the ground under the foot to its 8 neighbours.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from footfall.planner import ground_under_feet
+    >>> from footfall.scenarios import Heightfield
+    >>> ramp = Heightfield(np.tile(0.5 * np.arange(5.0), (5, 1)), origin_x=0.0, origin_z=0.0, cell_size=1.0)
+    >>> slope, rough = ground_under_feet(ramp, np.array([[2.0, 2.0]]), 1.0)
+    >>> round(float(slope[0]), 4), float(rough[0])      # atan(0.5); a step of 0.5 m to the x neighbours
+    (0.4636, 0.5)
+    """
+    feet_xz = np.asarray(feet_xz, dtype=np.float64).reshape(-1, 2)
+    x, z = feet_xz[:, 0], feet_xz[:, 1]
+    d = np.array([-spacing, 0.0, spacing])
+    h = terrain.height_at(x[:, None, None] + d[None, None, :], z[:, None, None] + d[None, :, None])  # (n, z, x)
+    centre = h[:, 1, 1]
+    slope = np.empty(x.size)
+    for i in range(x.size):
+        gx = _minmod(h[i, 1, 2] - centre[i], centre[i] - h[i, 1, 0]) / spacing
+        gz = _minmod(h[i, 2, 1] - centre[i], centre[i] - h[i, 0, 1]) / spacing
+        slope[i] = math.atan(math.hypot(gx, gz))
+    rough = np.abs(h - centre[:, None, None]).reshape(x.size, 9).max(axis=1)
+    return slope, rough
