@@ -15,7 +15,8 @@ def ground_under_feet(terrain, feet_xz: np.ndarray, spacing: float) -> tuple[np.
     """The slope and roughness of the ground under feet: the planner's footprint features
     (``planner._kernels_foot.footprint_features``: the slope from one-sided differences through the
     slope limiter, the roughness as the largest height step to the 8 neighbours) read on the terrain's
-    heights at ``spacing`` around each foot.
+    heights at ``spacing`` around each foot. The terrain's ground only: a foot on a safe box's top
+    reads the ground under the box (the styles measured with it are tuned on open ground).
 
     Parameters
     ----------
