@@ -38,7 +38,8 @@ MATRIX_FILE = Path(__file__).resolve().parent / "data" / "matrix.json"
 ROUGH_GROUND = "hills@terrain.amplitude=0.15,terrain.wavelength=1.2,terrain.octaves=3,terrain.persistence=0.5"
 """Rough ground, the styles' training terrain: bumps 0.15 m high, 0.3-1.2 m long. On the built-in
 ``hills`` (wavelengths 2-5 m) the footholds within a stride share one slope, so no weight can choose
-a flatter one; here they differ within a stride (the spider's default touch-downs: ~0.2 rad)."""
+a flatter one; here they differ within a stride (the defaults' touch-downs stand on 0.07-0.09 rad,
+read at the planner's cell spacing by :func:`footfall.planner.ground_under_feet`)."""
 TERRAINS = {
     "stairs": "stairs@terrain.rise=0.1,terrain.run=0.3",
     "crates": "crates@seed=13",
