@@ -641,7 +641,7 @@ meet the terrain, checked on held-out variants (a terrain or style preset).
     from footfall._distribute import check_workers
     from footfall.tuning._tune import TuneConfig, check_creature, check_output, tune
 
-    from footfall.scenarios import load_creature, split_scenario_list
+    from footfall.scenarios import load_creature
 
     check_workers(workers, cluster)
     check_creature(creature)
@@ -656,7 +656,7 @@ meet the terrain, checked on held-out variants (a terrain or style preset).
         if start_timing:
             raise InputError("argument", "--start-timing", "tunes the timing; --scenarios/--targets tune the weights")
         load_tune_targets(targets, creature)  # a malformed file: one line, before any work
-        names = check_scenarios(split_scenario_list(scenarios)) if scenarios is not None else DEFAULT_SCENARIOS
+        names = check_scenarios(scenarios) if scenarios is not None else DEFAULT_SCENARIOS
         config = EventTuneConfig(creature, scenarios=names, targets_file=targets, seed=seed, characters=characters,
                                  frames=frames, seeds=tuple(range(seeds)),
                                  holdout_seeds=tuple(range(101, 101 + seeds)),
@@ -744,10 +744,9 @@ def bench_tuning_cmd(
     check_creature(creature)
     with _err().status("benchmarking the tuning...") as status:
         if scenarios is not None:
-            from footfall.scenarios import split_scenario_list
             from footfall.tuning._tune_events import check_scenarios
 
-            result = run_events(creature, check_scenarios(split_scenario_list(scenarios)), seed=seed, max_evals=max_evals,
+            result = run_events(creature, check_scenarios(scenarios), seed=seed, max_evals=max_evals,
                                 rounds=max(rounds, 1), progress=lambda m: status.update(f"benchmarking: {m}"))
         else:
             result = run(creature, seed=seed, max_evals=max_evals, rounds=rounds,

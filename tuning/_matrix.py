@@ -77,8 +77,8 @@ PRESETS = {
     "spider-mixed": {"creature": "spider", "terrain": "mixed",
                      "command": "footfall tune --creature spider --scenarios mixed --characters 3 "
                                 "--out tuning/data/presets/spider-mixed.json"},
-    # The styles on rough ground: their quantities (touch-down slope, distance walked) depend there on
-    # which footholds the weights choose. On crates and mixed the direct style's tune kept the defaults
+    # The sure-footed and direct styles are tuned on rough ground: their quantities (touch-down slope,
+    # distance walked) depend there on which footholds the weights choose. On crates and mixed the direct style's tune kept the defaults
     # (holds and steering set the distance walked), on stairs its weights were spider-stairs's, and on
     # the 1 cm stairs the sure-footed style had no slope left to move (the defaults' touch-downs are flat).
     "spider-surefooted": {"creature": "spider", "style": "tuning/data/styles/sure-footed.toml", "terrains": ("rough",),

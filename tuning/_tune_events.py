@@ -143,11 +143,12 @@ class EventTuneConfig:
         return {k: list(v) if isinstance(v, tuple) else v for k, v in dataclasses.asdict(self).items()}
 
 
-def check_scenarios(names) -> tuple[str, ...]:
-    """Every scenario loads (one line on the first that does not)."""
-    from footfall.scenarios import load_scenario
+def check_scenarios(text: str) -> tuple[str, ...]:
+    """The scenarios of a command line's ``--scenarios A,B,...`` (a variant's overrides kept with it,
+    :func:`footfall.scenarios.split_scenario_list`); every one loads (one line on the first that does not)."""
+    from footfall.scenarios import load_scenario, split_scenario_list
 
-    names = tuple(n.strip() for n in names if n.strip())
+    names = split_scenario_list(text)
     if not names:
         raise InputError("argument", "--scenarios", "expected NAME[,NAME...]")
     for name in names:
