@@ -139,19 +139,21 @@ def _sample(top, origin_x, origin_z, cell, x, z):
 
 
 @nb.njit(cache=True, parallel=True)
-def pelvis_from_hulls(top, origin_x, origin_z, cell, pelvis, heading, support, in_stance, lands, body_length, body_width,
-                      standing_height, heights, body_thickness, bob, smoothing, last_base, last_pitch, last_roll, out_y,
-                      out_pitch, out_roll, out_base):
+def pelvis_from_hulls(top, origin_x, origin_z, cell, pelvis, heading, support, feet_now, in_stance, lands, body_length,
+                      body_width, standing_height, heights, body_thickness, bob, smoothing, last_base, last_pitch, last_roll,
+                      out_y, out_pitch, out_roll, out_base):
     """Write pelvis height, pitch, roll and the base height (the pelvis's before the bob).
 
-    ``support`` (C, L, 3): the feet used for the hull; ``in_stance`` (C, L): the feet on the ground
+    ``support`` (C, L, 3): the feet used for the hull; ``feet_now`` (C, L, 3): where the feet are this
+    frame (a swinging foot on its path); ``in_stance`` (C, L): the feet on the ground
     (a swinging foot's landing point lowers no pelvis: the stance legs would have to fold for it);
     ``lands`` (C, L): the feet that stand or will land (a foot tucked up, with no footprint, is no
     support point at all: as one it tilted the body by 5 degrees and dropped it by 2.4 cm);
     ``bob`` (C,) the bobbing offset;
     ``heights`` (L, 2) m: the least and most the pelvis stands above each leg's foot along its up
     axis (:func:`planner._workspace.height_ranges`; the least for stance feet only, the most for
-    every support point);
+    every support point; a swinging foot's leg also folds to where the foot is now, as far as the stance
+    legs let the body rise);
     ``body_thickness`` (m): the least it stands above the ground under its body box;
     ``smoothing`` in (0, 1]: the fraction of the way from ``last_base``, ``last_pitch``, ``last_roll``
     (C,) to this frame's that the body goes (module doc).
@@ -227,6 +229,18 @@ def pelvis_from_hulls(top, origin_x, origin_z, cell, pelvis, heading, support, i
             if stance_point[k]:
                 low = max(low, foot + cpcr * least[k])
                 high = min(high, foot + cpcr * most[k])
+        # A foot stepping down off a crate leaves the hull at lift-off (its landing point is the support),
+        # but it swings over the crate's top first: with the body dropped to the landing's hull, a
+        # quadruped's leg could not fold to it, and the drawn foot passed 8 mm inside the crate's edge
+        # (crates-moving, seed 2132651497, LOD zoomed, character 1, frame 243). The body stays high
+        # enough for every swinging leg's least height over its foot now, where the stance legs allow.
+        swing_low = -np.inf
+        for i in range(n_legs):
+            if lands[c, i] and not in_stance[c, i]:
+                dx = feet_now[c, i, 0] - px
+                dz = feet_now[c, i, 2] - pz
+                foot = _ground_along_up(feet_now[c, i, 1], dx * cs + dz * sn, -dx * sn + dz * cs, sp, cpsr)
+                swing_low = max(swing_low, foot + cpcr * heights[i, 0])
         base = max(min(h + standing_height, reach), low)
         if smoothing < 1.0:
             # The lag is the body's; the stance feet's reach and the ground under the body are hard
@@ -236,6 +250,7 @@ def pelvis_from_hulls(top, origin_x, origin_z, cell, pelvis, heading, support, i
         else:
             y_body = min(h + standing_height + bob[c], reach)
         y_body = max(y_body, low)
+        y_body = max(y_body, min(swing_low, high))
         ground = max(max(y[0], y[1]), max(y[2], max(yl[0], yl[2])))
         y_body = max(y_body, ground + body_thickness)
         out_base[c] = base

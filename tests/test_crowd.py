@@ -1011,3 +1011,31 @@ def test_a_stance_foot_steps_out_of_turn_only_when_it_holds_the_body_under_half_
     # Asked nothing, the floor counts: half of STEP_FOR_ASKED x goal, above the cap, so it steps.
     goal = 1.01 * cap / (0.5 * STEP_FOR_ASKED)
     assert forced(goal, 0.0).tolist() == [j]
+
+
+def test_a_swinging_leg_left_off_its_path_by_its_few_sweeps_gets_a_stance_legs():
+    # crates-moving, 8 quadrupeds, seed 5008, LOD off, frame 380: character 1 lifts its leg 3 off a
+    # crate while its body stands rolled by 0.36 rad; the leg's pose from the frame before is bent to
+    # its limits (knee 2.0 of 2.2, ankle -1.56 of -1.6). A swinging leg's 4 sweeps left the foot 3.7 mm
+    # off its path, 4 mm inside the crate (the premise, from the numbers of that frame); the stance
+    # leg's sweeps after them draw it on the path.
+    from footfall.planner._crowd import _solve_feet, _solve_into_state
+
+    scenario, creature = load_scenario("flat"), load_creature("quadruped")
+    model, state = init_crowd(scenario, creature, load_gait(default_gait_name("quadruped"), creature),
+                              n_characters=1, seed=0, lod_mode="off")
+    ctl = model.controller
+    state.heading[0], state.pitch[0], state.roll[0] = 0.76565574, -0.13322731, 0.35836469
+    state.feet[0, 3] = (-4.58081329, 0.10858258, 3.20381199)
+    state.in_stance[0, 3] = False
+    warm = np.array([0.1902809, 2.00067815, -0.29239517, -1.55984691])
+    hips = np.zeros(state.feet.shape)
+    hips[0, 3] = (-4.59447182, 0.48348489, 3.33197481)
+    one, leg = np.zeros(1, np.int64), np.full(1, 3)
+    state.angles[0, 3] = warm
+    few = _solve_feet(model, state, one, leg, hips[one, leg], ctl.ik_swing_iterations, ctl.ik_restarts)
+    assert few.residual[0] > 10 * ctl.ik_slip_margin  # the premise: 3.7 mm
+    state.angles[0, 3] = warm
+    _solve_into_state(model, state, one, leg, hips, False, ctl.ik_restarts)
+    assert state.residual[0, 3] <= ctl.ik_slip_margin
+    np.testing.assert_allclose(state.fk_feet[0, 3], state.feet[0, 3], atol=ctl.ik_slip_margin)

@@ -24,13 +24,15 @@ STANDING, THICKNESS = 0.3, 0.01
 FEET = np.array([[[0.5, 0.2, 0.5], [-0.5, 0.2, 0.5], [0.5, 0.0, -0.5], [-0.5, 0.0, -0.5]]])
 
 
-def _pose(smoothing, last, most=10.0, feet=FEET):
+def _pose(smoothing, last, most=10.0, feet=FEET, least=0.0, feet_now=None, in_stance=None):
     """(y, pitch, roll, base) of the scene's body, from the last frame's (base, pitch, roll)."""
     top = np.zeros((5, 5))
-    heights = np.tile([0.0, most], (4, 1))
+    heights = np.tile([least, most], (4, 1))
     out = [np.empty(1) for _ in range(4)]
-    pelvis_from_hulls(top, -2.5, -2.5, 1.0, np.array([[0.0, 0.4, 0.0]]), np.zeros(1), feet,
-                      np.ones((1, 4), np.bool_), np.ones((1, 4), np.bool_), 0.2, 0.2, STANDING, heights, THICKNESS,
+    feet_now = feet if feet_now is None else feet_now
+    in_stance = np.ones((1, 4), np.bool_) if in_stance is None else in_stance
+    pelvis_from_hulls(top, -2.5, -2.5, 1.0, np.array([[0.0, 0.4, 0.0]]), np.zeros(1), feet, feet_now,
+                      in_stance, np.ones((1, 4), np.bool_), 0.2, 0.2, STANDING, heights, THICKNESS,
                       np.zeros(1), smoothing,
                       np.array([last[0]]), np.array([last[1]]), np.array([last[2]]), *out)
     return tuple(float(o[0]) for o in out)
@@ -115,3 +117,32 @@ def test_carried_tilt_by_hand():
     assert carried_tilt(1.0, 0.0, s, y, t, 4, stance, least, most, 0.0) == 1.0
     # No tilt reaches (a pelvis 2 m up): the one that leaves the least violation, upright.
     assert carried_tilt(1.0, 0.0, s, y, t, 4, stance, least, most, 2.0) == 0.0
+
+
+FLAT = np.array([[[0.5, 0.0, 0.5], [-0.5, 0.0, 0.5], [0.5, 0.0, -0.5], [-0.5, 0.0, -0.5]]])
+SWINGING_FRONT_LEFT = np.array([[False, True, True, True]])
+
+
+def _swing_over(height):
+    """The flat stance with the front-left foot swinging at ``height`` above its landing point."""
+    now = FLAT.copy()
+    now[0, 0, 1] = height
+    return now
+
+
+@pytest.mark.parametrize(("swing_height", "most", "expected"), [
+    (0.0, 10.0, 0.3),    # a foot swinging low asks nothing: the pelvis at standing height
+    (0.04, 10.0, 0.3),   # 0.04 + 0.25 under the standing 0.3: still nothing
+    (0.15, 10.0, 0.4),   # 0.15 + 0.25: the body rises so the swinging leg folds to its foot
+    (0.15, 0.35, 0.35),  # ... only as far as the stance legs reach (0.35 above their feet)
+])
+def test_the_body_stays_high_enough_for_a_swinging_leg_to_fold_to_its_foot(swing_height, most, expected):
+    """A foot stepping down off a crate swings over its top after its landing point has lowered the
+    hull (crates-moving, quadruped, seed 2132651497: the body dropped 5.5 cm at lift-off, the leg could
+    not fold to the foot, and the drawn foot passed 8 mm inside the crate). Flat ground, legs that
+    stand 0.25-``most`` m above their feet, standing height 0.3: the pelvis is at least the swinging
+    foot's height + 0.25, and never above a stance foot's reach."""
+    y, pitch, roll, base = _pose(1.0, (0.0, 0.0, 0.0), most=most, feet=FLAT, least=0.25,
+                                 feet_now=_swing_over(swing_height), in_stance=SWINGING_FRONT_LEFT)
+    assert (pitch, roll) == pytest.approx((0.0, 0.0), abs=TOL)
+    assert y == pytest.approx(expected, abs=TOL)
