@@ -2268,9 +2268,9 @@ def _take_back_poses(model: CrowdModel, state: CrowdState, bad: np.ndarray) -> N
 
 def _solve_into_state(model: CrowdModel, state: CrowdState, cs, ls, hips, stance: bool, restarts: int) -> None:
     """CCD for legs (cs, ls) from ``hips`` (C, L, 3), all standing (``stance``) or all swinging, into
-    the state's angles, residuals and drawn feet: a stance leg gets ``ik_iterations`` sweeps, a
-    swinging one ``ik_swing_iterations``, and a stance leg's where those leave it over
-    ``ik_slip_margin`` off its foot. A swinging leg's few sweeps follow a foot that moves smoothly;
+    the state's angles, residuals and drawn feet: a stance leg gets ``ik_iterations`` sweeps; a swinging
+    one ``ik_swing_iterations`` and, where those leave it over ``ik_slip_margin`` off its foot, a stance
+    leg's sweeps and restarts from there. A swinging leg's few sweeps follow a foot that moves smoothly;
     where the body's pose jumps (the hull at a lift-off) they left a quadruped's foot 3.7 mm off its
     path, 4 mm inside the crate it lifted from (crates-moving, seed 5008, LOD off, character 1, leg 3,
     frame 380)."""
