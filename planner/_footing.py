@@ -4,11 +4,14 @@ touch-down metrics)."""
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from footfall.planner._kernels_foot import _minmod
+from footfall.planner._kernels_foot import footprint_features
+from footfall.planner.layout import FEAT_ROUGHNESS, FEAT_SLOPE, N_FEATURES
+
+_CENTRE = 4
+"""The foot's cell in its 3 x 3 neighbourhood, flattened row by row (z, then x)."""
+_NO_LEGS = np.zeros((0, 4))
 
 
 def ground_under_feet(terrain, feet_xz: np.ndarray, spacing: float) -> tuple[np.ndarray, np.ndarray]:
@@ -48,11 +51,15 @@ def ground_under_feet(terrain, feet_xz: np.ndarray, spacing: float) -> tuple[np.
     x, z = feet_xz[:, 0], feet_xz[:, 1]
     d = np.array([-spacing, 0.0, spacing])
     h = terrain.height_at(x[:, None, None] + d[None, None, :], z[:, None, None] + d[None, :, None])  # (n, z, x)
-    centre = h[:, 1, 1]
+    # The planner's own features (one definition), on each foot's 3 x 3 neighbourhood: the terrain's
+    # heights stand for both its dilated and raw elevation, with no other leg to cross.
+    cells = np.ascontiguousarray(h.reshape(x.size, 9))
+    features = np.empty(N_FEATURES)
     slope = np.empty(x.size)
+    rough = np.empty(x.size)
     for i in range(x.size):
-        gx = _minmod(h[i, 1, 2] - centre[i], centre[i] - h[i, 1, 0]) / spacing
-        gz = _minmod(h[i, 2, 1] - centre[i], centre[i] - h[i, 0, 1]) / spacing
-        slope[i] = math.atan(math.hypot(gx, gz))
-    rough = np.abs(h - centre[:, None, None]).reshape(x.size, 9).max(axis=1)
+        footprint_features(_CENTRE, x[i], z[i], cells[i], cells[i], np.zeros(9), 3, x[i], z[i], x[i], z[i], _NO_LEGS,
+                           spacing, features)
+        slope[i] = features[FEAT_SLOPE]
+        rough[i] = features[FEAT_ROUGHNESS]
     return slope, rough
