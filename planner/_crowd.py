@@ -408,6 +408,8 @@ class CrowdState:
     gait_index: np.ndarray  # (C,) int: the schedule's gait each character walks with (or moves toward)
     stride_frequency: np.ndarray  # (C,) Hz, the needle's rate at the last gait stage
     turn_wanted: np.ndarray  # (C,) rad, the turn the steering asked of the last frame, before the stance feet bound it
+    turn_left: np.ndarray  # (C,) rad, the turn the steering still asks after the last frame's (stage_plan predicts it)
+    turn_made: np.ndarray  # (C,) rad, the turn the last steer stage made (its stance feet may hold it under the rate)
     threatened: np.ndarray  # (C, L) bool: a moving box reaches the stance foot within the threat horizon
     tucked: np.ndarray  # (C, L) bool: a threatened foot with no footprint, held up near its hip (tuck_swings)
     escaping: np.ndarray  # (C,) bool: the last steer stage turned the character out of a moving box's lane
@@ -584,7 +586,12 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
     # its heading as ORCA's velocity goes.
     backward = in_lane & avoided & fast & ((velocity * direction).sum(axis=1) < 0.0)
     backward &= ~among_others
-    direction = np.where((avoided & fast & ~backward)[:, None],
+    # The heading follows ORCA's velocity wherever it is not the one asked: avoiding, or kept right of a
+    # neighbour (_avoid) and otherwise unhindered. Following it only while avoiding, an ant walking
+    # abreast of another on `stairs` turned +-0.05 rad every frame between its way and the kept-right
+    # velocity, avoiding one frame and not the next (seed 3000, character 1, frames 15-140).
+    steered = np.hypot(*(velocity - preferred).T) > 1e-9
+    direction = np.where((steered & fast & ~backward)[:, None],
                          velocity / np.maximum(np.hypot(*velocity.T), 1e-12)[:, None], direction)
     desired = np.arctan2(direction[:, 1], direction[:, 0])
     turn = _wrap(desired - state.heading)
@@ -601,7 +608,13 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
     state.escaping = in_lane
     state.turn_wanted = np.clip(turn, -rate, rate)
     lo, hi = stance_turn_bounds(model, state)
-    state.heading = _wrap(state.heading + uncrossing_turn(model, state, np.clip(state.turn_wanted, lo, hi)))
+    applied = uncrossing_turn(model, state, np.clip(state.turn_wanted, lo, hi))
+    state.heading = _wrap(state.heading + applied)
+    # What is left of the turn as far as the stance feet let it go on (they bound it each frame until
+    # they lift): a quadruped's foot planned for the whole turn asked, its stance feet then holding the
+    # body, landed across its midline (`crates-moving`, seed 4001, character 3, frame 176).
+    state.turn_left = np.clip(turn, lo, hi) - applied
+    state.turn_made = applied
     forward = np.cos(np.clip(turn, -np.pi / 2, np.pi / 2))
     # Unhindered, a character keeps walking (at least 30 %) while it turns, an escaper at its flee speed
     # held to FLEE_GAIN_MAX of the asked one; avoiding, it walks only as far along its heading as the
@@ -1345,6 +1358,25 @@ def arrival_speed(distance, arrive_radius: float, acceleration: float):
     return np.sqrt(2.0 * acceleration * np.maximum(np.asarray(distance, dtype=np.float64) - arrive_radius, 0.0))
 
 
+def touchdown_turn(turn_left, turn_made, dt, t):
+    """rad: how far a body turns in ``t`` s (a swing): the turn its steering still asks, ``turn_left``,
+    at the rate it turned in the last frame (``turn_made`` rad in ``dt`` s), no further than asked.
+    The rate is the one it made, not the controller's: a quadruped whose stance feet held its turn to
+    a fiftieth of the rate, planned for the full rate over its 0.3 s swing, set a front foot across its
+    body's midline (`mixed`, seed 3007, character 2, frame 112).
+
+    Examples
+    --------
+    >>> from footfall.planner._crowd import touchdown_turn
+    >>> float(touchdown_turn(1.0, 0.05, 0.03125, 0.25))   # 1.6 rad/s for 0.25 s
+    0.4
+    >>> float(touchdown_turn(-0.1, -0.05, 0.03125, 0.25)), float(touchdown_turn(1.0, 0.0, 0.03125, 0.25))
+    (-0.1, 0.0)
+    """
+    limit = np.abs(turn_made) / dt * np.asarray(t, dtype=float)
+    return np.clip(turn_left, -limit, limit)
+
+
 def travel(speed, goal, acceleration: float, duration):
     """Distance (m) a body at ``speed`` covers in ``duration`` (s) while it changes speed toward
     ``goal`` at ``acceleration`` (m/s^2) and then keeps it (all broadcast).
@@ -1844,7 +1876,10 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     until_next = np.mod(g.dest_start[cs, ls] - landing_phase, 1.0)
     t_stance = np.clip(until_next, 0.5 * nominal, 1.5 * nominal) / freq
     heading = state.heading[cs]
-    fwd = np.stack([np.cos(heading), np.sin(heading)], axis=1)
+    # The heading at touchdown: the body goes on turning at the rate it turns while its steering still
+    # asks a turn (touchdown_turn). Planned for the heading at lift-off, a turning spider's side feet
+    # landed a stride's turn times their 0.3 m reach ahead of or behind their rest points.
+    turn = touchdown_turn(state.turn_left[cs], state.turn_made[cs], model.dt, t_swing)
     v = state.speed[cs]
     # Where the body will be: it keeps accelerating toward the speed the steering asked (a foot planned
     # at the start of a speed-up would otherwise land for the slower speed and trail out of reach).
@@ -1852,7 +1887,11 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     # `crates` spider's feet landed for a body 1 / 0.72 as fast as the one that walked.
     goal = state.speed_wanted[cs]
     travel_swing = travel(v, goal, model.controller.acceleration, t_swing)
-    pred = state.pelvis[cs][:, [0, 2]] + fwd * travel_swing[:, None]
+    # along the chord of the arc it turns on
+    chord = np.stack([np.cos(heading + 0.5 * turn), np.sin(heading + 0.5 * turn)], axis=1)
+    pred = state.pelvis[cs][:, [0, 2]] + chord * travel_swing[:, None]
+    heading = heading + turn
+    fwd = np.stack([np.cos(heading), np.sin(heading)], axis=1)
     spacing = state.feet_spacing[cs]
     # The stance sweep v * T_stance is centred inside the leg's stance window (planner._workspace):
     # a leg whose rest foot sits near an end of its window would run out of reach before lift-off.
@@ -1935,7 +1974,7 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     state.swing_target[vc, vl] = out.target[ok]
     state.in_stance[vc, vl] = False
     state.wants_swing[vc, vl] = False
-    state.plan_heading[vc, vl] = heading[ok]
+    state.plan_heading[vc, vl] = state.heading[vc]  # at lift-off: a re-plan is for a turn off the plan's
     state.plan_speed[vc, vl] = v[ok]
     state.plan_spacing[vc, vl] = spacing[ok]
     state.foot_yaws[vc, vl] = foot_yaw[ok]
@@ -2605,7 +2644,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         feet_spacing=np.ones(n), plan_spacing=np.ones((n, L)), foot_yaws=yaws,
         gaits=init_gaits([schedule.gaits[int(k)] for k in gait_index], n, rng.uniform(0.0, 1.0, n)), angles=angles, residual=np.zeros((n, L)),
         ik_on=np.zeros(n, np.bool_), fk_feet=feet.copy(), pelvis_base=np.zeros(n), pelvis_rise=np.zeros(n), body_held=np.zeros(n, np.bool_), speed_limit=np.full(n, np.inf), last_move=np.zeros((n, 2)), cannot_follow=np.zeros((n, L), np.bool_), unfollowed=np.zeros((n, L), np.bool_), pose_before=np.zeros((n, 7)),
-        gait_index=gait_index, stride_frequency=np.zeros(n), turn_wanted=np.zeros(n),
+        gait_index=gait_index, stride_frequency=np.zeros(n), turn_wanted=np.zeros(n), turn_left=np.zeros(n), turn_made=np.zeros(n),
         threatened=np.zeros((n, L), np.bool_), tucked=np.zeros((n, L), np.bool_),
         escaping=np.zeros(n, np.bool_), goal_speed=np.full(n, speed), speed_wanted=np.zeros(n), blocks_escape=np.zeros((n, L), np.bool_), crossed=np.zeros((n, L, L), np.bool_),
         counters={k: 0 for k in ("steps", "plans", "holds", "replans", "forbidden_footprints", "cells_expanded",

@@ -604,6 +604,140 @@ def test_a_stance_leg_carried_across_another_leg_steps():
     assert not forced()[:2].any()
 
 
+def _planned_preferred(model, state, leg, monkeypatch):
+    """(preferred footprint (2,), swing time) of one new step of ``leg`` planned from a copy of ``state``
+    (the stage_plan call of a frame, no steering before it)."""
+    import copy
+
+    import footfall.planner._crowd as crowd
+
+    state = copy.deepcopy(state)
+    seen = {}
+    original = crowd._plan_groups
+
+    def capture(model, state, request, *args, **kwargs):
+        seen["preferred"] = request.preferred.copy()
+        return original(model, state, request, *args, **kwargs)
+
+    monkeypatch.setattr(crowd, "_plan_groups", capture)
+    kinds = np.zeros(state.in_stance.shape, np.int8)
+    kinds[0, leg] = 1
+    boxes = _no_boxes()
+    chars = np.array([0])
+    groups = crowd.map_groups(model, state, chars)
+    maps = [crowd.stage_maps(model, state, group, boxes, None) for group, _ in groups]
+    crowd.stage_plan(model, state, kinds, np.zeros(1), crowd.character_budgets(model, state, boxes), maps, groups,
+                     hips_world(model, state), boxes)
+    monkeypatch.undo()
+    return seen["preferred"][0], float(state.swing_T[0, leg])
+
+
+def test_a_foot_is_planned_for_the_heading_its_body_will_have_turned_to_at_touchdown(monkeypatch):
+    """A body still turning keeps turning while the foot swings (at the rate it turned in the last frame,
+    no further than its steering asks): the foot is planned where its rest point will be then. Planned
+    for the heading at lift-off, a turning spider's side feet landed a stride's turn times their 0.3 m
+    reach ahead of or behind their rest points, and a `crates` crowd's per-stride error p90 reached 0.29
+    (seed 3002). Planned for the controller's full rate, a quadruped whose stance feet held its turn
+    set a front foot across its midline (`mixed`, seed 3007)."""
+    model, state, _ = _standing_on_flat("spider")
+    state.speed_wanted[0] = 0.0  # standing: the body turns on the spot, its hips round the pelvis
+    leg, h = 0, float(state.heading[0])
+    rate = model.controller.turn_rate * model.dt  # the most a frame turns
+
+    def planned(heading, turn_left, turn_made):
+        state.heading[0], state.turn_left[0], state.turn_made[0] = heading, turn_left, turn_made
+        return _planned_preferred(model, state, leg, monkeypatch)
+
+    straight, t_swing = planned(h, 0.0, 0.0)
+    frames = t_swing / model.dt
+    assert frames > 2.0, "the swing must leave time for the turns below"
+    # Turning at the full rate, half the turn it makes in the swing left: as if already turned, bit for bit.
+    turn = 0.5 * rate * frames
+    np.testing.assert_array_equal(planned(h, turn, rate)[0], planned(h + turn, 0.0, 0.0)[0])
+    assert np.hypot(*(planned(h, turn, rate)[0] - straight)) > 0.01, "the turn must move the footprint"
+    # A turn asked beyond what the swing's time allows at that rate: the rate x the swing's time.
+    np.testing.assert_array_equal(planned(h, -1.0, -rate)[0], planned(h - rate / model.dt * t_swing, 0.0, 0.0)[0])
+    np.testing.assert_array_equal(planned(h, -1.0, -0.25 * rate)[0],
+                                  planned(h - 0.25 * rate / model.dt * t_swing, 0.0, 0.0)[0])
+    # A body its stance feet hold from turning plans for the heading it has.
+    np.testing.assert_array_equal(planned(h, 1.0, 0.0)[0], straight)
+
+
+def test_a_character_kept_right_of_its_neighbours_walks_a_steady_heading():
+    """Kept KEEP_RIGHT right of its way by near neighbours and otherwise unhindered, a character heads along
+    the kept-right velocity. It used to head along it only while ORCA bent it further, and along its way
+    otherwise: an ant walking abreast of others on `stairs` turned +-0.05 rad every frame (seed 3000,
+    character 1, frames 15-140; 154 such reversals among the 6 ants in 300 frames)."""
+    from footfall.planner._crowd import KEEP_RIGHT, NEAR_RADII, step
+
+    scenario, creature = load_scenario("stairs"), load_creature("ant")
+    gait, _, _ = resolve_gait(None, creature)
+    model, state = init_crowd(scenario, creature, gait, n_characters=6, seed=3000)
+    rate = model.controller.turn_rate * model.dt
+    turns, off_way, nearest = [], [], []
+    for k in range(140):
+        before = state.heading.copy()
+        step(model, state)
+        if k >= 15:
+            turns.append(np.angle(np.exp(1j * (state.heading - before))))
+            way = state.route[1, state.route_index[1]] - state.pelvis[1, [0, 2]]
+            off_way.append(np.angle(np.exp(1j * (state.heading[1] - math.atan2(way[1], way[0])))))
+            gaps = np.hypot(*(state.pelvis[:, [0, 2]] - state.pelvis[1, [0, 2]]).T)
+            nearest.append(np.sort(gaps)[1])
+    turns = np.array(turns)
+    assert max(nearest) < NEAR_RADII * model.avoid_radius, "the premise: character 1 walks among neighbours"
+    reversals = (np.abs(turns[1:]) >= 0.5 * rate) & (np.abs(turns[:-1]) >= 0.5 * rate) \
+        & (np.sign(turns[1:]) != np.sign(turns[:-1]))
+    assert reversals[:, 1].sum() == 0, np.flatnonzero(reversals[:, 1]) + 16
+    assert np.abs(turns[:, 1]).max() < 0.5 * rate
+    # right of its way (y up, walking +x: toward -z), by about KEEP_RIGHT
+    np.testing.assert_allclose(off_way, -KEEP_RIGHT, rtol=0, atol=0.5 * KEEP_RIGHT)
+
+
+def test_a_character_with_a_neighbour_near_keeps_right_even_when_orca_has_nothing_to_avoid(monkeypatch):
+    """Two spiders walking at each other on lines 0.75 m apart: ORCA has nothing to avoid (their discs pass
+    clear), yet each keeps KEEP_RIGHT right of its way, and turns that way at its full rate. Following
+    ORCA's velocity only while it avoided, a character kept right turned to its way one frame and to the
+    kept-right velocity the next (a +-0.05 rad chatter)."""
+    import footfall.planner._crowd as crowd
+    from footfall.planner._crowd import KEEP_RIGHT, _boxes_now, stage_steer
+
+    scenario, creature = load_scenario("flat"), load_creature("spider")
+    model, state = init_crowd(scenario, creature, load_gait(default_gait_name("spider"), creature), n_characters=2,
+                              seed=0, lod_mode="off", raster=_raster(scenario, creature))
+    # Character 1 turned half round its pelvis and carried 1 m ahead of character 0, 0.75 m to its side
+    # (NEAR_RADII avoid radii: 1.36 m; their discs: 0.68 m).
+    start = state.pelvis[0, [0, 2]].copy()
+    goal = start + [1.0, 0.75]
+    pivot = state.pelvis[1, [0, 2]].copy()
+    for field in (state.feet, state.fk_feet, state.swing_target):
+        field[1][..., [0, 2]] = goal - (field[1][..., [0, 2]] - pivot)
+    state.trajectories[1][..., [0, 2]] = goal - (state.trajectories[1][..., [0, 2]] - pivot)
+    state.pelvis[1, [0, 2]] = goal
+    state.heading[:] = [0.0, math.pi]
+    state.foot_yaws[1] += math.pi
+    state.route[0], state.route[1] = start + [10.0, 0.0], goal - [10.0, 0.0]
+    state.speed[:] = 0.3
+    seen = {}
+    real_avoid = crowd._avoid
+
+    def avoid(model, state, preferred, *rest):
+        out = real_avoid(model, state, preferred, *rest)
+        seen.update(avoided=out[1].copy(), near=out[2].copy(), velocity=out[0].copy())
+        return out
+
+    monkeypatch.setattr(crowd, "_avoid", avoid)
+    stage_steer(model, state, _boxes_now(model, state.t))
+    assert seen["near"].all(), "the premise: each has the other near"
+    assert not seen["avoided"].any(), "the premise: ORCA has nothing to avoid"
+    rate = model.controller.turn_rate * model.dt
+    assert rate < KEEP_RIGHT
+    # Right of +x is -z (y up); right of -x is +z: each turns right at the full rate.
+    np.testing.assert_allclose(state.turn_wanted, [-rate, -rate], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(np.arctan2(seen["velocity"][:, 1], seen["velocity"][:, 0]),
+                               [-KEEP_RIGHT, math.pi - KEEP_RIGHT], rtol=0, atol=1e-9)
+
+
 def test_a_turn_is_bounded_by_the_stance_feet_nearest_the_midline():
     # A quadruped at heading 0 on its four feet, each at 0.3 m ahead of or behind the pelvis and
     # 0.15 m to its side, all lifting next frame: a turn of a swings a front foot 0.3 a sideways, so

@@ -424,7 +424,9 @@ def preferred_footprint(timing, situations: Situations):
     """(F, 2) the preferred footprint at timing ``theta``; = the harvest's at theta_0.
 
     P moves along each situation's heading by v (g(theta) - g(theta_0)), g the
-    :func:`preferred_lead_time`.
+    :func:`preferred_lead_time`. For a body still turning, the runtime also turns P with the turn a
+    longer or shorter swing makes (``planner._crowd.touchdown_turn``); the proxy keeps the heading of
+    the lift-off, exact at theta_0 and for straight walking.
 
     Parameters
     ----------
