@@ -1358,22 +1358,34 @@ def arrival_speed(distance, arrive_radius: float, acceleration: float):
     return np.sqrt(2.0 * acceleration * np.maximum(np.asarray(distance, dtype=np.float64) - arrive_radius, 0.0))
 
 
+TOUCHDOWN_TURN_MAX = 0.1
+"""rad: the most of a turn a foot is planned ahead for (:func:`touchdown_turn`). A steering can turn
+back (an escape, ORCA's velocity): quadrupeds' front feet planned for the 0.45 rad a turn at the full
+rate makes over their 0.3 s swing, the turn then reversed, landed across their midline
+(`crates-moving`, seeds 3000 and 4001, 6 and 6 crossing frames; none with the cap). 0.1 rad moves a
+spider's foot at most 3 cm, a quadruped's front foot 2.7 cm: under half its hip's 0.1 m sideways offset."""
+
+
 def touchdown_turn(turn_left, turn_made, dt, t):
     """rad: how far a body turns in ``t`` s (a swing): the turn its steering still asks, ``turn_left``,
-    at the rate it turned in the last frame (``turn_made`` rad in ``dt`` s), no further than asked.
-    The rate is the one it made, not the controller's: a quadruped whose stance feet held its turn to
-    a fiftieth of the rate, planned for the full rate over its 0.3 s swing, set a front foot across its
-    body's midline (`mixed`, seed 3007, character 2, frame 112).
+    at the rate it turned in the last frame (``turn_made`` rad in ``dt`` s), no further than asked and
+    at most :data:`TOUCHDOWN_TURN_MAX`. The rate is the one it made, not the controller's: a quadruped
+    whose stance feet held its turn to a fiftieth of the rate, planned for the full rate over its 0.3 s
+    swing, set a front foot across its body's midline (`mixed`, seed 3007, character 2, frame 112).
 
     Examples
     --------
     >>> from footfall.planner._crowd import touchdown_turn
-    >>> float(touchdown_turn(1.0, 0.05, 0.03125, 0.25))   # 1.6 rad/s for 0.25 s
-    0.4
-    >>> float(touchdown_turn(-0.1, -0.05, 0.03125, 0.25)), float(touchdown_turn(1.0, 0.0, 0.03125, 0.25))
-    (-0.1, 0.0)
+    >>> float(touchdown_turn(1.0, 0.05, 0.03125, 0.0625))   # 1.6 rad/s for 0.0625 s
+    0.1
+    >>> float(touchdown_turn(1.0, 0.025, 0.03125, 0.0625))  # 0.8 rad/s
+    0.05
+    >>> float(touchdown_turn(1.0, 0.05, 0.03125, 0.25))   # ... for 0.25 s: 0.4, at most TOUCHDOWN_TURN_MAX
+    0.1
+    >>> float(touchdown_turn(-0.05, -0.05, 0.03125, 0.25)), float(touchdown_turn(1.0, 0.0, 0.03125, 0.25))
+    (-0.05, 0.0)
     """
-    limit = np.abs(turn_made) / dt * np.asarray(t, dtype=float)
+    limit = np.minimum(np.abs(turn_made) / dt * np.asarray(t, dtype=float), TOUCHDOWN_TURN_MAX)
     return np.clip(turn_left, -limit, limit)
 
 

@@ -634,11 +634,14 @@ def _planned_preferred(model, state, leg, monkeypatch):
 
 def test_a_foot_is_planned_for_the_heading_its_body_will_have_turned_to_at_touchdown(monkeypatch):
     """A body still turning keeps turning while the foot swings (at the rate it turned in the last frame,
-    no further than its steering asks): the foot is planned where its rest point will be then. Planned
+    no further than its steering asks, at most TOUCHDOWN_TURN_MAX): the foot is planned where its rest point will be then. Planned
     for the heading at lift-off, a turning spider's side feet landed a stride's turn times their 0.3 m
     reach ahead of or behind their rest points, and a `crates` crowd's per-stride error p90 reached 0.29
     (seed 3002). Planned for the controller's full rate, a quadruped whose stance feet held its turn
-    set a front foot across its midline (`mixed`, seed 3007)."""
+    set a front foot across its midline (`mixed`, seed 3007); planned for the whole turn, quadrupeds
+    whose turn reversed did (`crates-moving`, seeds 3000 and 4001)."""
+    from footfall.planner._crowd import TOUCHDOWN_TURN_MAX
+
     model, state, _ = _standing_on_flat("spider")
     state.speed_wanted[0] = 0.0  # standing: the body turns on the spot, its hips round the pelvis
     leg, h = 0, float(state.heading[0])
@@ -650,15 +653,17 @@ def test_a_foot_is_planned_for_the_heading_its_body_will_have_turned_to_at_touch
 
     straight, t_swing = planned(h, 0.0, 0.0)
     frames = t_swing / model.dt
-    assert frames > 2.0, "the swing must leave time for the turns below"
-    # Turning at the full rate, half the turn it makes in the swing left: as if already turned, bit for bit.
-    turn = 0.5 * rate * frames
+    slow = 0.25 * rate  # a turn its stance feet slow to a quarter of the rate
+    assert TOUCHDOWN_TURN_MAX < rate * frames and slow * frames < TOUCHDOWN_TURN_MAX, \
+        "the swing must be long enough for the cap, short enough for the slow turn"
+    # Half the most it turns in the swing left: as if already turned, bit for bit.
+    turn = 0.5 * TOUCHDOWN_TURN_MAX
     np.testing.assert_array_equal(planned(h, turn, rate)[0], planned(h + turn, 0.0, 0.0)[0])
-    assert np.hypot(*(planned(h, turn, rate)[0] - straight)) > 0.01, "the turn must move the footprint"
-    # A turn asked beyond what the swing's time allows at that rate: the rate x the swing's time.
-    np.testing.assert_array_equal(planned(h, -1.0, -rate)[0], planned(h - rate / model.dt * t_swing, 0.0, 0.0)[0])
-    np.testing.assert_array_equal(planned(h, -1.0, -0.25 * rate)[0],
-                                  planned(h - 0.25 * rate / model.dt * t_swing, 0.0, 0.0)[0])
+    assert np.hypot(*(planned(h, turn, rate)[0] - straight)) > 0.005, "the turn must move the footprint"
+    # More asked than the swing's time allows at the rate it turns: the rate x the swing's time ...
+    np.testing.assert_array_equal(planned(h, -1.0, -slow)[0], planned(h - slow / model.dt * t_swing, 0.0, 0.0)[0])
+    # ... and at most TOUCHDOWN_TURN_MAX (a steering can turn back).
+    np.testing.assert_array_equal(planned(h, -1.0, -rate)[0], planned(h - TOUCHDOWN_TURN_MAX, 0.0, 0.0)[0])
     # A body its stance feet hold from turning plans for the heading it has.
     np.testing.assert_array_equal(planned(h, 1.0, 0.0)[0], straight)
 
