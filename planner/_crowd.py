@@ -2881,9 +2881,9 @@ def step(model: CrowdModel, state: CrowdState) -> StepRecord:
     >>> record = step(model, state)
     >>> state.frame, round(state.t, 4)
     (1, 0.0333)
-    >>> for _ in range(29):                         # one second in all
+    >>> for _ in range(44):                         # 1.5 s in all
     ...     record = step(model, state)
-    >>> state.speed                                 # up to speed at 1 m/s^2
+    >>> state.speed                                 # up to speed at 1 m/s^2, each kept right of the other
     array([0.3, 0.3])
     >>> import numpy as np
     >>> state.counters["steps"] > 0, bool(np.isfinite(state.pelvis).all())
