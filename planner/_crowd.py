@@ -426,14 +426,19 @@ class CrowdState:
 def hips_world(model: CrowdModel, state: CrowdState) -> np.ndarray:
     """(C, L, 3) hip positions: body-frame hips rotated by heading, pitch and roll
     (the rotation of :func:`planner._ik.body_rotation`)."""
+    return state.pelvis[:, None, :] + _hip_offsets(model, state, slice(None))
+
+
+def _hip_offsets(model: CrowdModel, state: CrowdState, chars) -> np.ndarray:
+    """(len(chars), L, 3) the hips of characters ``chars`` (an index or a slice) from their pelvis."""
     from footfall.planner._ik import body_rotation
 
-    rotation = body_rotation(state.heading, state.pitch, state.roll)[:, None]  # (C, 1, 3, 3): forward, up, left
+    # (C, 1, 3, 3): forward, up, left
+    rotation = body_rotation(state.heading[chars], state.pitch[chars], state.roll[chars])[:, None]
     h = model.hips_body[None, :, None, :]  # (1, L, 1, 3)
     # R @ hip written out, in the order einsum summed it (x + z, then y: the same bits; einsum's order
     # follows its operands' memory layout), at two thirds of its cost for a crowd.
-    rotated = (rotation[..., 0] * h[..., 0] + rotation[..., 2] * h[..., 2]) + rotation[..., 1] * h[..., 1]
-    return state.pelvis[:, None, :] + rotated
+    return (rotation[..., 0] * h[..., 0] + rotation[..., 2] * h[..., 2]) + rotation[..., 1] * h[..., 1]
 
 
 def sustained_speed(state: CrowdState) -> np.ndarray:
@@ -689,11 +694,18 @@ def _box_gap_out(x, z, centre, half, yaw):
 
 def shove_out_of_moving_boxes(model: CrowdModel, state: CrowdState, boxes) -> None:
     """A moving box (``boxes`` as :func:`_boxes_now` gives them) that a character's escape did not keep
-    clear shoves it: where the box comes nearer to a foot in the air than the foot's half diagonal and
-    :data:`SHOVE_MARGIN`, the body and its feet in the air (their swings too) move straight out from the
-    box's nearest point to the pelvis until every such foot keeps that margin; feet in stance stay where
-    they stand (a threatened one steps away or tucks: ``stage_requests``). Counted in
-    ``state.counters["shoves"]`` (characters shoved, per frame; ``box_shoves`` in a run's summary).
+    clear shoves it: where the box comes nearer to a foot in the air, or to the hip of its leg, than the
+    foot's half diagonal and :data:`SHOVE_MARGIN`, the body and its feet in the air (their swings too) move
+    straight out from the box's nearest point to the pelvis until every such foot and hip keeps that
+    margin; feet in stance stay where they stand (a threatened one steps away or tucks:
+    ``stage_requests``). Counted in ``state.counters["shoves"]`` (characters shoved, per frame;
+    ``box_shoves`` in a run's summary).
+
+    The hips since 2026-11-28: a tucked foot is held near its hip (:data:`TUCK_REACHES`), where the IK may
+    draw it centimetres off its tuck point. With the feet alone, an ant between its neighbours and
+    ``mixed``'s looping crate had its tucked feet drawn 0.5-3.4 cm inside the crate in 3 frames (64 ants,
+    seed 2, character 34: the crowd bar's 3 feet in boxes on session 51's machine; 0 with the hips). The
+    crowds issue's bar sets (seeds 3000-3009, 4000-4009) have no shove and ran bit for bit the same.
 
     Before it (2026-11-27), a tucked foot whose tuck points the box already covered stayed under the box
     while the body was still beside it: the crowd bar's 64 characters (``mixed`` and ``crates``, seeds
@@ -712,14 +724,20 @@ def shove_out_of_moving_boxes(model: CrowdModel, state: CrowdState, boxes) -> No
     close = np.hypot(*(xz[:, None, :] - centres[index][None, :, [0, 2]]).transpose(2, 0, 1)) < reach[None]
     need = 0.5 * math.hypot(model.creature.foot_length, model.creature.foot_width) + SHOVE_MARGIN
     shoved = np.zeros(xz.shape[0], np.bool_)
-    for c, k in zip(*np.nonzero(close)):  # few: the bodies a moving box is beside this frame
+    pairs = np.nonzero(close)
+    if not pairs[0].size:
+        return
+    offsets = dict(zip(pairs[0].tolist(), _hip_offsets(model, state, pairs[0])))
+    for c, k in zip(*pairs):  # few: the bodies a moving box is beside this frame
         b = index[k]
         air = np.flatnonzero(~state.in_stance[c])
         if not air.size:
             continue
         yaw, centre = float(yaws[b]), centres[b, [0, 2]]
         for _ in range(SHOVE_ROUNDS):
-            gap = min(_box_gap_out(state.feet[c, j, 0], state.feet[c, j, 2], centre, half[k], yaw)[0] for j in air)
+            hips = state.pelvis[c] + offsets[int(c)]
+            gap = min(min(_box_gap_out(state.feet[c, j, 0], state.feet[c, j, 2], centre, half[k], yaw)[0],
+                          _box_gap_out(hips[j, 0], hips[j, 2], centre, half[k], yaw)[0]) for j in air)
             short = need - gap
             if short <= 0.0:
                 break
