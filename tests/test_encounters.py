@@ -868,11 +868,12 @@ def test_a_moving_box_that_reaches_a_foot_in_the_air_shoves_the_body_and_its_fee
 
 
 def test_a_moving_box_that_reaches_the_hip_of_a_leg_in_the_air_shoves_the_body_as_far():
-    # The same spider, leg 0 in the air, its foot tucked in 0.1 m behind its hip (-x); a crate 0.2 m deep
-    # and 1 m wide whose -x face is 5 mm beyond that hip (+x). The foot is 0.105 m from the face, clear by
-    # far; the hip is not, and the IK renders a foot held near its hip anywhere about it. The body goes
-    # straight -x until the hip keeps the foot's half diagonal and the margin from the face. Only the feet
-    # in the air count: a stance leg's hip as near (the legs beside leg 0) shoves nothing.
+    # The same spider, leg 1 in the air (its hip at x = 0.02 m), its foot tucked in 0.1 m behind that hip
+    # (-x); a crate 0.2 m deep and 1 m wide whose -x face is 5 mm beyond that hip (+x). The foot is 0.105 m
+    # from the face, clear by far; the hip is not, and the IK draws a foot held near its hip anywhere about
+    # it. The body goes straight -x until that hip keeps the foot's half diagonal and the margin from the
+    # face. Only the legs in the air count: the stance legs 0 and 4, their hips at x = 0.045 m inside the
+    # crate, would push it 2.5 cm further; with every foot down nothing moves.
     from footfall.planner import _crowd as crowd
 
     spider = load_creature("spider")
@@ -880,25 +881,26 @@ def test_a_moving_box_that_reaches_the_hip_of_a_leg_in_the_air_shoves_the_body_a
     state.pelvis[0, [0, 2]] = 0.0
     state.heading[0] = state.pitch[0] = state.roll[0] = 0.0
     state.in_stance[0] = True
-    hip = crowd.hips_world(model, state)[0, 0]
-    assert abs(hip[2]) < 0.5  # the pelvis projects onto the crate's -x face
+    hips = crowd.hips_world(model, state)[0]
+    hip = hips[1]
+    assert abs(hip[2]) < 0.5 and hips[[0, 4], 0].min() > hip[0] + 0.02  # the pelvis projects onto the -x face
     need = 0.5 * math.hypot(spider.foot_length, spider.foot_width) + crowd.SHOVE_MARGIN
     crate = (np.array([[hip[0] + 0.005 + 0.1, 0.1, hip[2]]]), np.array([[0.2, 0.2, 1.0]]), np.zeros(1),
              np.ones(1, np.bool_), np.ones(1, np.bool_))
     crowd.shove_out_of_moving_boxes(model, state, crate)  # every foot on the ground: nothing to shove
     assert state.counters["shoves"] == 0 and state.pelvis[0, 0] == 0.0
 
-    state.in_stance[0, 0] = False
-    state.feet[0, 0, [0, 2]] = [hip[0] - 0.1, hip[2]]
-    state.trajectories[0, 0, :, 0], state.trajectories[0, 0, :, 2] = hip[0] - 0.1, hip[2]
+    state.in_stance[0, 1] = False
+    state.feet[0, 1, [0, 2]] = [hip[0] - 0.1, hip[2]]
+    state.trajectories[0, 1, :, 0], state.trajectories[0, 1, :, 2] = hip[0] - 0.1, hip[2]
     before = state.feet.copy()
     crowd.shove_out_of_moving_boxes(model, state, crate)
     assert state.counters["shoves"] == 1
     np.testing.assert_allclose(state.pelvis[0, [0, 2]], [-(need - 0.005), 0.0], atol=1e-12)
-    np.testing.assert_allclose(state.feet[0, 0, [0, 2]], [hip[0] - 0.1 - (need - 0.005), hip[2]], atol=1e-12)
-    np.testing.assert_array_equal(state.feet[0, 1:], before[0, 1:])  # the stance feet stay
-    # The hip now keeps exactly that distance from the face.
-    moved = crowd.hips_world(model, state)[0, 0]
+    np.testing.assert_allclose(state.feet[0, 1, [0, 2]], [hip[0] - 0.1 - (need - 0.005), hip[2]], atol=1e-12)
+    np.testing.assert_array_equal(state.feet[0, [0, *range(2, 8)]], before[0, [0, *range(2, 8)]])  # stance feet stay
+    # That hip now keeps exactly that distance from the face.
+    moved = crowd.hips_world(model, state)[0, 1]
     assert (hip[0] + 0.005) - moved[0] == pytest.approx(need, abs=1e-12)
 
 
