@@ -21,6 +21,7 @@ keeps one client (and local cluster) for many calls; :func:`run_tasks` is one ca
 from __future__ import annotations
 
 import functools
+import logging
 import os
 from contextlib import contextmanager
 from typing import Callable, Iterator, Sequence
@@ -82,9 +83,12 @@ def task_runner(workers: int | None = None, cluster: str | None = None) -> Itera
     local = None
     try:
         if cluster is None:
-            # Loopback only, no dashboard: nothing listens beyond this machine.
+            # Loopback only, no dashboard: nothing listens beyond this machine. The workers' own logs only
+            # at CRITICAL: closing the cluster on a busy machine, a worker's last heartbeat found the
+            # scheduler gone and printed a 30-line traceback under a finished `footfall evaluate`. A task's
+            # error still reaches the caller (the client raises it).
             local = LocalCluster(n_workers=workers or default_workers(), threads_per_worker=1, processes=True,
-                                 host="127.0.0.1", dashboard_address=None)
+                                 host="127.0.0.1", dashboard_address=None, silence_logs=logging.CRITICAL)
             client = Client(local)
         else:
             try:

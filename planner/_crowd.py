@@ -286,6 +286,7 @@ class CrowdModel:
     # cap, at most Froude number ESCAPE_FROUDE. A box at least this fast cannot be escaped.
     top_speed: float = math.inf
     height_range: np.ndarray | None = None  # (L, 2) m, least and most pelvis height above each foot (planner._workspace)
+    tuck_reach: np.ndarray | None = None  # (L, len(TUCK_REACHES)) the tuck points' reaches the legs reach (planner._workspace)
     # The far levels of detail's planner settings (planner._far_planning): the first try and the fallback,
     # both on compact maps; None with lod_mode 'off' (every character plans as the paper does).
     far_first: PlannerConfig | None = None
@@ -2052,7 +2053,12 @@ spiders, 1200 frames, seed 3: 41 foot-frames in the crate, 34 with these; over 1
 frames on crates-moving and mixed, 3574 -> 3011, leg crossings 351 -> 355). Not under the hip (reach
 0): the leg's plane is undefined there and its knee swung across a neighbour's leg; nor under the body
 (negative), where legs crossed five times as often. The foot is checked without the threat margin:
-with it, feet moved in that the box would not have touched, and their swings out again crossed it."""
+with it, feet moved in that the box would not have touched, and their swings out again crossed it.
+Each leg holds its foot at the nearest of these, out from it, that its folded leg reaches
+(``CrowdModel.tuck_reach``, :func:`planner._workspace.tuck_reaches`): an ant reaches none of them (its
+least is 0.3-0.35), and the IK drew its feet 2.5-3 cm off their tuck points, into the crate they were
+kept clear of (``mixed``, 64 ants, seed 3). Spiders and 5-legged robots reach all three; a quadruped,
+lifting its foot half its hip's height, none at any reach, and keeps these."""
 
 
 def tuck_points(model: CrowdModel, state: CrowdState, cs, ls, hips, boxes=None) -> np.ndarray:
@@ -2060,17 +2066,22 @@ def tuck_points(model: CrowdModel, state: CrowdState, cs, ls, hips, boxes=None) 
     offset from its hip, on its own side (its leg crosses no other), TUCK_LIFT of the hip's height
     above the ground under the hip. Where that point is inside one of ``boxes`` (as
     :func:`_planning_boxes` gives them: where each is now and, a moving one, where it is heading),
-    the first of :data:`TUCK_REACHES` that is clear, else the last."""
+    the first of :data:`TUCK_REACHES` that is clear, else the last (each as far out as the leg reaches:
+    ``model.tuck_reach``)."""
     rest = model.rest_body[ls] * state.feet_spacing[cs, None]
     hip = hips[cs, ls]
     height = model.creature.standing_height + model.hips_body[ls, 1]
 
-    def at(reach):
+    # The reaches the folded legs reach (init_crowd; TUCK_REACHES for a model built without them).
+    reaches = model.tuck_reach[ls] if model.tuck_reach is not None else np.tile(TUCK_REACHES, (len(ls), 1))
+
+    def at(level):
+        reach = reaches[:, level]
         ox, oz = _rot_xz(state.heading[cs], reach * (rest[:, 0] - model.hips_body[ls, 0]),
                          reach * (rest[:, 1] - model.hips_body[ls, 2]))
         return np.column_stack([hip[:, 0] + ox, hip[:, 1] - (1.0 - TUCK_LIFT) * height, hip[:, 2] + oz])
 
-    points = at(TUCK_REACHES[0])
+    points = at(0)
     if boxes is None or not len(boxes[0]):
         return points
     centres, sizes, yaws, forbidden, _ = boxes
@@ -2084,10 +2095,10 @@ def tuck_points(model: CrowdModel, state: CrowdState, cs, ls, hips, boxes=None) 
         return out
 
     blocked = np.flatnonzero(inside(np.arange(len(cs))))
-    for reach in TUCK_REACHES[1:]:
+    for level in range(1, len(TUCK_REACHES)):
         if not blocked.size:
             break
-        points[blocked] = at(reach)[blocked]
+        points[blocked] = at(level)[blocked]
         blocked = blocked[inside(blocked)]
     return points
 
@@ -2612,7 +2623,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         raise ValueError(f"raster: cell size {raster.frame.cell_size} differs from the planner's {config.cell_size}")
     from footfall.planner._gait_schedule import as_schedule
     from footfall.planner._timing import GRAVITY, hip_height
-    from footfall.planner._workspace import height_ranges, speed_cap, stance_windows
+    from footfall.planner._workspace import height_ranges, speed_cap, stance_windows, tuck_reaches
 
     schedule = as_schedule(gait)
     window = stance_windows(creature, rest_body, hips_body, leg_static)
@@ -2634,6 +2645,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         leg_static=leg_static, fixed_budget=budget, schedule=schedule, stance_window=window, speed_cap=cap,
         speed_asked=speed_asked, step_height=step_height, top_speed=max(escape, speed),
         height_range=height_ranges(creature, rest_body, hips_body, leg_static), far_first=far_first,
+        tuck_reach=tuck_reaches(creature, rest_body, hips_body, leg_static, TUCK_REACHES, TUCK_LIFT),
         far_fallback=far_fallback)
     rng = np.random.default_rng(seed)
     positions = spawn_positions(scenario, creature, n)

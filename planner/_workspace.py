@@ -49,7 +49,7 @@ _CACHE: dict = {}
 def _cached(kind: str, creature, rest_body, hips_body, legs, compute):
     """Windows and steps depend only on the legs' geometry: computed once per geometry (each costs a
     few thousand IK solves), then shared by every crowd of that creature."""
-    key = (kind, creature.name, float(creature.standing_height), np.asarray(creature.leg_reach).tobytes(),
+    key = (kind if isinstance(kind, str) else repr(kind), creature.name, float(creature.standing_height), np.asarray(creature.leg_reach).tobytes(),
            rest_body.tobytes(), hips_body.tobytes(), legs.segment_lengths.tobytes(), legs.limits.tobytes(),
            legs.rest_azimuths.tobytes(), np.asarray(legs.azimuth_limits).tobytes(), legs.plane_rolls.tobytes())
     if key not in _CACHE:
@@ -290,6 +290,50 @@ def highest_step(creature, rest_body: np.ndarray, hips_body: np.ndarray, legs) -
     hips_body = np.ascontiguousarray(hips_body, dtype=np.float64)
     return _cached("step", creature, rest_body, hips_body, legs,
                    lambda: _highest_step(creature, rest_body, hips_body, legs))
+
+
+def tuck_reaches(creature, rest_body: np.ndarray, hips_body: np.ndarray, legs, asked, lift: float) -> np.ndarray:
+    """(L, K) the fractions of each leg's rest offset from its hip at which a tucked foot is held:
+    for each of ``asked`` (K,), the least one from it up (in steps of :data:`TUCK_REACH_STEP`) whose
+    point, ``lift`` of the hip's height above the ground under the hip, the leg's IK reaches (level
+    body, joint limits included): a point nearer the hip than the folded leg reaches
+    is drawn centimetres off by the IK (``planner._crowd.tuck_points``); where none is, the asked one.
+
+    Parameters
+    ----------
+    creature, rest_body, hips_body, legs
+        As :func:`stance_windows`.
+    asked : sequence of float
+        The wanted fractions, outermost first.
+    lift : float
+        The tuck point's height above the ground, as a fraction of the hip's height.
+    """
+    rest_body = np.ascontiguousarray(rest_body, dtype=np.float64)
+    hips_body = np.ascontiguousarray(hips_body, dtype=np.float64)
+    asked = tuple(float(a) for a in asked)
+    return _cached(("tucks", asked, float(lift)), creature, rest_body, hips_body, legs,
+                   lambda: _tuck_reaches(creature, rest_body, hips_body, legs, asked, lift))
+
+
+TUCK_REACH_STEP = 0.05
+"""Step (x the rest offset) in which :func:`tuck_reaches` moves an unreachable tuck point outwards."""
+
+
+def _tuck_reaches(creature, rest_body, hips_body, legs, asked, lift) -> np.ndarray:
+    n_legs = rest_body.shape[0]
+    grid = np.round(np.arange(0.0, 1.0 + 1e-9, TUCK_REACH_STEP), 10)
+    k = grid.size
+    up = hips_body[:, 1] - (1.0 - lift) * (float(creature.standing_height) + hips_body[:, 1])
+    forward = hips_body[:, 0:1] + grid[None, :] * (rest_body[:, 0:1] - hips_body[:, 0:1])
+    lateral = hips_body[:, 2:3] + grid[None, :] * (rest_body[:, 1:2] - hips_body[:, 2:3])
+    targets = np.stack([forward, np.broadcast_to(up[:, None], forward.shape), lateral], axis=-1).reshape(-1, 3)
+    reached = _reached(hips_body, legs, np.repeat(np.arange(n_legs), k), targets).reshape(n_legs, k)
+    out = np.ones((n_legs, len(asked)))
+    for i in range(n_legs):
+        for j, a in enumerate(asked):
+            ok = np.flatnonzero(reached[i] & (grid >= a - 1e-9))
+            out[i, j] = grid[ok[0]] if ok.size else a
+    return out
 
 
 def _highest_step(creature, rest_body, hips_body, legs) -> float:

@@ -42,6 +42,19 @@ def test_local_worker_processes_give_the_in_process_results(quick_tasks, in_proc
     assert [without_timings(r) for r in results] == [without_timings(r) for r in in_process[:3]]
 
 
+def _fails(task: dict) -> dict:
+    if task["k"] == 1:
+        raise ValueError(f"task {task['k']} failed")
+    return task
+
+
+def test_a_task_that_fails_on_a_local_worker_raises_in_the_caller():
+    # The local workers log only at CRITICAL (a heartbeat's traceback at close is noise), so a task's
+    # error must still reach the caller, named.
+    with pytest.raises(ValueError, match="task 1 failed"):
+        run_tasks(_fails, [{"k": 0}, {"k": 1}], workers=2)
+
+
 @pytest.mark.parametrize("workers, cluster, field", [(0, None, "--workers"), (2, "tcp://127.0.0.1:1", "--workers"),
                                                      (None, "127.0.0.1:8786", "--cluster")])
 def test_bad_worker_options_are_refused(workers, cluster, field):

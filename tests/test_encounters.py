@@ -951,3 +951,50 @@ def test_a_tucked_foot_beside_a_moving_crate_never_swings_into_it():
         counters.update(state)
         in_boxes.append(counters.collisions - before)
     assert sum(in_boxes) == 0, [f for f, n in enumerate(in_boxes) if n]
+
+
+@pytest.mark.parametrize("name", ["ant", "spider", "robot5"])
+def test_every_tuck_point_is_one_its_leg_reaches_and_the_nearest_such_to_the_asked(name):
+    # A tucked foot is held TUCK_REACHES of its rest offset out from its hip, TUCK_LIFT of the hip's height
+    # above the ground. An ant's folded leg does not reach that near its hip: at 0.05 the IK drew the foot
+    # 2.5-3 cm off its tuck point, 0.6 cm into the crate the tuck point kept clear of (mixed, 64 ants, seed
+    # 3, character 19, frame 439). Each leg's reaches (model.tuck_reach) are the asked ones where the IK
+    # reaches them (the spider: all), else the nearest reached one out from them, in TUCK_REACH_STEP steps.
+    from footfall.planner._crowd import TUCK_LIFT, TUCK_REACHES, hips_world, tuck_points
+    from footfall.planner._ik import legs_of, solve_legs
+    from footfall.planner._workspace import REACH_TOLERANCE, TUCK_REACH_STEP
+
+    creature = load_creature(name)
+    model, state = init_crowd(load_scenario("flat"), creature, gait_schedule(creature), n_characters=1, seed=0)
+    legs = legs_of(creature)
+    n = model.n_legs
+    hips_body, rest = model.hips_body, model.rest_body
+    up = hips_body[:, 1] - (1.0 - TUCK_LIFT) * (creature.standing_height + hips_body[:, 1])
+
+    def missed(reach):
+        """(L,) m: how far the IK (level body, body frame) leaves each foot from its tuck point at ``reach``."""
+        target = np.column_stack([hips_body[:, 0] + reach * (rest[:, 0] - hips_body[:, 0]), up,
+                                  hips_body[:, 2] + reach * (rest[:, 1] - hips_body[:, 2])])
+        result = solve_legs(hips_body, np.broadcast_to(np.eye(3), (n, 3, 3)), legs.rest_azimuths, legs.segment_lengths,
+                            legs.limits, legs.azimuth_limits, target, max_iterations=48, restarts=8,
+                            plane_rolls=legs.plane_rolls)
+        return result.residual
+
+    reaches = model.tuck_reach
+    assert reaches.shape == (n, len(TUCK_REACHES))
+    for level, asked in enumerate(TUCK_REACHES):
+        got = reaches[:, level]
+        assert (got >= asked - 1e-12).all()
+        assert (missed(got) < REACH_TOLERANCE).all(), (level, got)
+        moved = got > asked + 1e-12
+        assert (missed(got - TUCK_REACH_STEP)[moved] > REACH_TOLERANCE).all(), "not the nearest reached one"
+    if name == "spider":
+        np.testing.assert_array_equal(reaches, np.tile(TUCK_REACHES, (n, 1)))
+    if name == "ant":
+        assert (missed(np.full(n, TUCK_REACHES[-1])) > 0.01).all()  # the premise: the asked innermost one is not reached
+    # tuck_points holds the feet there (heading 0: body forward +x, left +z; no box: the first reach).
+    chars, every = np.zeros(n, np.int64), np.arange(n)
+    hips = hips_world(model, state)
+    point = tuck_points(model, state, chars, every, hips)
+    np.testing.assert_allclose(point[:, [0, 2]] - hips[0, :, [0, 2]].T,
+                               reaches[:, :1] * (rest - hips_body[:, [0, 2]]), atol=1e-12)
