@@ -998,3 +998,51 @@ def test_every_tuck_point_is_one_its_leg_reaches_and_the_nearest_such_to_the_ask
     point = tuck_points(model, state, chars, every, hips)
     np.testing.assert_allclose(point[:, [0, 2]] - hips[0, :, [0, 2]].T,
                                reaches[:, :1] * (rest - hips_body[:, [0, 2]]), atol=1e-12)
+
+
+def test_a_shoved_body_pushes_the_bodies_it_runs_into_by_the_same_move():
+    # Three spiders heading 0 (+x), placed by hand along -x: spider 0 at the origin with leg 0 in the air, spider 1 just behind it (its body box 1 mm clear of
+    # 0's), spider 2 far behind. A crate 5 mm beyond 0's foot in the air shoves 0 straight -x by
+    # need - 5 mm (as the test above): 0's body now overlaps 1's, so 1 goes by the same move (its feet in
+    # the air too, its stance feet stay); 2, which 1 does not reach, stays. Without neighbours (or with
+    # none near) only 0 moves.
+    from footfall.planner import _crowd as crowd
+    from footfall.planner._kernels_geometry import rects_overlap
+
+    spider = load_creature("spider")
+    model, state = init_crowd(load_scenario("flat"), spider, gait_schedule(spider), n_characters=3, seed=0)
+    length = float(spider.body_box[0])
+    state.heading[:] = 0.0
+    state.pelvis[:, [0, 2]] = [[0.0, 0.0], [-(length + 0.001), 0.0], [-3.0, 0.0]]
+    state.in_stance[:] = True
+    state.in_stance[[0, 1], 0] = False
+    state.feet[0, 0, [0, 2]] = [0.15, 0.05]
+    state.trajectories[0, 0, :, 0], state.trajectories[0, 0, :, 2] = 0.15, 0.05
+    need = 0.5 * math.hypot(spider.foot_length, spider.foot_width) + crowd.SHOVE_MARGIN
+    crate = (np.array([[0.15 + 0.005 + 0.1, 0.1, 0.05]]), np.array([[0.2, 0.2, 0.2]]), np.zeros(1),
+             np.ones(1, np.bool_), np.ones(1, np.bool_))
+    neighbours = (np.array([0, 2, 4, 6]), np.array([1, 2, 0, 2, 0, 1]))  # everyone's neighbours: the others
+    push = np.array([-(need - 0.005), 0.0])
+    assert push[0] < -0.001  # the premise: 0's shove is more than the 1 mm gap
+
+    def shoved(with_neighbours):
+        s = crowd.CrowdState(**{f: (v.copy() if isinstance(v, np.ndarray) else v) for f, v in vars(state).items()})
+        s.counters = dict(state.counters)
+        crowd.shove_out_of_moving_boxes(model, s, crate, neighbours if with_neighbours else None)
+        return s
+
+    alone = shoved(False)
+    np.testing.assert_allclose(alone.pelvis[0, [0, 2]] - state.pelvis[0, [0, 2]], push, atol=1e-12)
+    np.testing.assert_array_equal(alone.pelvis[1:], state.pelvis[1:])
+    hx, hz = 0.5 * length, 0.5 * float(spider.body_box[1])
+    assert rects_overlap(*alone.pelvis[0, [0, 2]], hx, hz, 0.0, *alone.pelvis[1, [0, 2]], hx, hz, 0.0)  # 0 in 1
+
+    both = shoved(True)
+    for c in (0, 1):
+        np.testing.assert_allclose(both.pelvis[c, [0, 2]] - state.pelvis[c, [0, 2]], push, atol=1e-12)
+        np.testing.assert_allclose(both.feet[c, 0, [0, 2]] - state.feet[c, 0, [0, 2]], push, atol=1e-12)
+        np.testing.assert_array_equal(both.feet[c, 1:], state.feet[c, 1:])  # the stance feet stay
+    np.testing.assert_array_equal(both.pelvis[2], state.pelvis[2])
+    np.testing.assert_array_equal(both.pelvis[:, 1], state.pelvis[:, 1])
+    assert both.counters["shoves"] == 1  # the box shoved one body; the other was pushed
+    assert not rects_overlap(*both.pelvis[0, [0, 2]], hx, hz, 0.0, *both.pelvis[1, [0, 2]], hx, hz, 0.0)
