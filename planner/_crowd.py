@@ -615,6 +615,10 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
     state.turn_wanted = np.clip(turn, -rate, rate)
     lo, hi = stance_turn_bounds(model, state)
     applied = uncrossing_turn(model, state, np.clip(state.turn_wanted, lo, hi))
+    # No turn into another body, as no step (bodies_apart): standing 7 cm beside another ant, one turned
+    # its body into the other's (mixed, 64 ants, seed 3, characters 34 and 19, with the hysteresis on
+    # can_make_way tried in session 52: README, crowds and moving boxes).
+    applied[~bodies_turn_clear(model, state, applied, neighbours)] = 0.0
     state.heading = _wrap(state.heading + applied)
     # What is left of the turn as far as the stance feet let it go on (they bound it each frame until
     # they lift): a quadruped's foot planned for the whole turn asked, its stance feet then holding the
@@ -719,7 +723,7 @@ def shove_out_of_moving_boxes(model: CrowdModel, state: CrowdState, boxes, neigh
     A shoved body pushes the bodies it would run into (``neighbours``, CSR lists as :func:`_avoid` gives
     them) by the same move, and they theirs (:func:`_push_bodies`): shoved alone, an ant was pushed 6 cm
     into its neighbour's body over 10 frames (``mixed``, 64 ants, seed 3, character 19, frames 450-460,
-    with :data:`MOBILE_BAND`'s hysteresis)."""
+    with the hysteresis on :func:`can_make_way` tried in session 52: README, crowds and moving boxes)."""
     centres, sizes, yaws, _, moving = boxes
     index = np.flatnonzero(moving)
     if not index.size:
@@ -1181,18 +1185,35 @@ def bodies_apart(model: CrowdModel, state: CrowdState, move: np.ndarray, neighbo
     or at least brings it no nearer to the ones it overlaps."""
     from footfall.planner._kernels_controller import moves_into_bodies
 
+    return _clear_of_bodies(model, state, moves_into_bodies, move, neighbours)
+
+
+def _clear_of_bodies(model: CrowdModel, state: CrowdState, kernel, change: np.ndarray, neighbours,
+                     grown: bool = True) -> np.ndarray:
+    """(C,) bool: not ``kernel`` (``planner._kernels_controller.moves_into_bodies`` or ``turns_into_bodies``)
+    for ``change`` (each character's move or turn), with the body box each character keeps out of the
+    others': the body, ``grown`` by half of :data:`BODY_GAP_FRAMES` frames at top speed."""
     start, index = neighbours
     n = state.pelvis.shape[0]
     if index.size == 0:
         return np.ones(n, np.bool_)
     box = model.creature.body_box
-    top = _fastest(model, state)
-    grow = 0.5 * BODY_GAP_FRAMES * top * model.dt
+    grow = 0.5 * BODY_GAP_FRAMES * _fastest(model, state) * model.dt if grown else 0.0
     into = np.empty(n, np.bool_)
-    moves_into_bodies(np.ascontiguousarray(state.pelvis[:, [0, 2]]), np.ascontiguousarray(state.heading),
-                      np.ascontiguousarray(move, dtype=np.float64), 0.5 * float(box[0]) + grow,
-                      0.5 * float(box[1]) + grow, start, index, into)
+    kernel(np.ascontiguousarray(state.pelvis[:, [0, 2]]), np.ascontiguousarray(state.heading),
+           np.ascontiguousarray(change, dtype=np.float64), 0.5 * float(box[0]) + grow, 0.5 * float(box[1]) + grow,
+           start, index, into)
     return ~into
+
+
+def bodies_turn_clear(model: CrowdModel, state: CrowdState, turn: np.ndarray, neighbours) -> np.ndarray:
+    """(C,) bool: characters whose ``turn`` (C,) rad on the spot keeps their body box out of the
+    ``neighbours``' it was out of. The bodies themselves, not grown as :func:`bodies_apart` grows them: grown
+    boxes 7 cm apart already overlap, and a standing ant turned into its neighbour (``mixed``, 64 ants,
+    seed 3, characters 34 and 19, with the hysteresis tried in session 52)."""
+    from footfall.planner._kernels_controller import turns_into_bodies
+
+    return _clear_of_bodies(model, state, turns_into_bodies, turn, neighbours, grown=False)
 
 
 def stance_room(model: CrowdModel, state: CrowdState) -> np.ndarray:

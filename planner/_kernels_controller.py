@@ -316,6 +316,31 @@ def moves_into_bodies(centres, headings, moves, half_length, half_width, neighbo
 
 
 @nb.njit(cache=True)
+def turns_into_bodies(centres, headings, turns, half_length, half_width, neighbour_start, neighbour_index, out):
+    """Per character c, True when turning its body box (half extents ``half_length`` x ``half_width``
+    along its heading, about its pelvis) by ``turns`` [c] makes it overlap a neighbour's (CSR
+    ``neighbour_start``, ``neighbour_index``; at the neighbour's heading before the turn) that it did not
+    overlap before: :func:`moves_into_bodies` for a turn on the spot."""
+    n = centres.shape[0]
+    for c in range(n):
+        out[c] = False
+        if turns[c] == 0.0:
+            continue
+        ax = centres[c, 0]
+        az = centres[c, 1]
+        turned = headings[c] + turns[c]
+        for a in range(neighbour_start[c], neighbour_start[c + 1]):
+            d = neighbour_index[a]
+            bx = centres[d, 0]
+            bz = centres[d, 1]
+            if rects_overlap(ax, az, half_length, half_width, turned, bx, bz, half_length, half_width, headings[d]) \
+                    and not rects_overlap(ax, az, half_length, half_width, headings[c], bx, bz, half_length, half_width,
+                                          headings[d]):
+                out[c] = True
+                break
+
+
+@nb.njit(cache=True)
 def count_close_pairs(points, owner, radius):
     """Pairs of points closer than ``radius`` (ground plane) that belong to different owners,
     through a uniform grid of cell ``radius`` (sorted cell keys), so it stays near linear."""

@@ -284,15 +284,20 @@ def test_neighbour_lists_equal_brute_force_on_random_crowds(seed):
         assert index[start[i]:start[i + 1]].tolist() == sorted(nearest.tolist()), f"seed {seed}, character {i}"
 
 
-def _moves_into(centres, headings, moves, half_length=0.1, half_width=0.05):
-    from footfall.planner._kernels_controller import moves_into_bodies
-
+def _into(kernel, centres, headings, changes, half_length, half_width):
+    """``kernel`` (moves_into_bodies or turns_into_bodies) for every character, everyone a neighbour."""
     centres = np.asarray(centres, np.float64)
     start, index = neighbour_lists(centres, 10.0)
     out = np.empty(centres.shape[0], np.bool_)
-    moves_into_bodies(centres, np.asarray(headings, np.float64), np.asarray(moves, np.float64), half_length,
-                      half_width, start, index, out)
+    kernel(centres, np.asarray(headings, np.float64), np.asarray(changes, np.float64), half_length, half_width,
+           start, index, out)
     return out.tolist()
+
+
+def _moves_into(centres, headings, moves, half_length=0.1, half_width=0.05):
+    from footfall.planner._kernels_controller import moves_into_bodies
+
+    return _into(moves_into_bodies, centres, headings, moves, half_length, half_width)
 
 
 def test_a_step_into_a_neighbours_body_is_refused_and_one_beside_or_away_is_not():
@@ -305,6 +310,28 @@ def test_a_step_into_a_neighbours_body_is_refused_and_one_beside_or_away_is_not(
     # Turned across (+z), the neighbour is 0.05 m deep along x instead of 0.1: 6 cm of air.
     assert _moves_into(centres, [0.0, math.pi / 2], [[0.05, 0.0], [0.0, 0.0]]) == [False, False]
     assert _moves_into(centres, [0.0, math.pi / 2], [[0.07, 0.0], [0.0, 0.0]]) == [True, False]
+
+
+def _turns_into(centres, headings, turns, half_length=0.1, half_width=0.02):
+    from footfall.planner._kernels_controller import turns_into_bodies
+
+    return _into(turns_into_bodies, centres, headings, turns, half_length, half_width)
+
+
+def test_a_turn_on_the_spot_into_a_neighbours_body_is_refused_and_a_smaller_one_is_not():
+    # Two bodies 0.2 x 0.04, both facing +x, side by side 6 cm apart along z: 2 cm of air between them.
+    centres, headings = [[0.0, 0.0], [0.0, 0.06]], [0.0, 0.0]
+    assert _turns_into(centres, headings, [math.pi / 2, 0.0]) == [True, False]  # across: through the other
+    # Turned 0.1 rad, the front left corner rises to 0.1 sin 0.1 + 0.02 cos 0.1 = 0.030 m, short of the
+    # other's side at 0.04; turned 0.3 rad, to 0.0296 + 0.0191 = 0.049 m: into it. Turned -0.3 rad, the
+    # back left corner rises as far.
+    assert _turns_into(centres, headings, [0.1, 0.0]) == [False, False]
+    assert _turns_into(centres, headings, [0.3, 0.0]) == [True, False]
+    assert _turns_into(centres, headings, [-0.3, 0.0]) == [True, False]
+    assert _turns_into(centres, headings, [-0.1, 0.0]) == [False, False]
+    assert _turns_into(centres, headings, [0.0, 0.0]) == [False, False]
+    # Bodies that already overlap may turn (the turn is no new overlap; a step apart parts them).
+    assert _turns_into([[0.0, 0.0], [0.0, 0.03]], headings, [0.3, 0.0]) == [False, False]
 
 
 def test_bodies_already_overlapping_may_part_but_not_press_further():

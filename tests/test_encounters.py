@@ -1046,3 +1046,29 @@ def test_a_shoved_body_pushes_the_bodies_it_runs_into_by_the_same_move():
     np.testing.assert_array_equal(both.pelvis[:, 1], state.pelvis[:, 1])
     assert both.counters["shoves"] == 1  # the box shoved one body; the other was pushed
     assert not rects_overlap(*both.pelvis[0, [0, 2]], hx, hz, 0.0, *both.pelvis[1, [0, 2]], hx, hz, 0.0)
+
+
+def test_a_standing_ant_may_not_turn_its_body_into_a_neighbour_7_cm_beside_it():
+    # Two ants (bodies 0.12 x 0.04 m) side by side, both heading +x, 7 cm apart along z: 3 cm of air. Their
+    # grown boxes (bodies_apart's, for steps) already touch, so a turn is checked on the bodies themselves.
+    # Turned 0.3 rad toward the other, the front corner rises to 0.06 sin 0.3 + 0.02 cos 0.3 = 0.037 m,
+    # short of the other's side at 0.05 m; turned 0.8 rad, to 0.043 + 0.014 = 0.057 m: into it (mixed, 64
+    # ants, seed 3: a standing ant turned into its neighbour while the grown boxes let it).
+    from footfall.planner import _crowd as crowd
+    from footfall.planner._kernels_avoidance import neighbour_lists
+
+    ant = load_creature("ant")
+    model, state = init_crowd(load_scenario("flat"), ant, gait_schedule(ant), n_characters=2, seed=0)
+    assert tuple(ant.body_box[:2]) == (0.12, 0.04)
+    state.heading[:] = 0.0
+    state.pelvis[:, [0, 2]] = [[0.0, 0.0], [0.0, 0.07]]
+    neighbours = neighbour_lists(np.ascontiguousarray(state.pelvis[:, [0, 2]]), 1.0)
+    assert not crowd.bodies_apart(model, state, np.array([[0.0, 0.001], [0.0, 0.0]]), neighbours)[0]  # grown: touching
+
+    def clear(turn):
+        return crowd.bodies_turn_clear(model, state, np.array([turn, 0.0]), neighbours).tolist()
+
+    assert clear(0.3) == [True, True]
+    assert clear(0.8) == [False, True]
+    assert clear(-0.8) == [False, True]  # the back corner rises as far
+    assert clear(0.0) == [True, True]
