@@ -2133,18 +2133,18 @@ def tuck_points(model: CrowdModel, state: CrowdState, cs, ls, hips, boxes=None) 
     :func:`_planning_boxes` gives them: where each is now and, a moving one, where it is heading),
     the first of :data:`TUCK_REACHES` that is clear, else the last (each as far out as the leg reaches:
     ``model.tuck_reach``)."""
+    from footfall.planner._workspace import tuck_drop
+
     rest = model.rest_body[ls] * state.feet_spacing[cs, None]
     hip = hips[cs, ls]
-    height = model.creature.standing_height + model.hips_body[ls, 1]
-
-    # The reaches the folded legs reach (init_crowd; TUCK_REACHES for a model built without them).
-    reaches = model.tuck_reach[ls] if model.tuck_reach is not None else np.tile(TUCK_REACHES, (len(ls), 1))
+    drop = tuck_drop(model.creature, model.hips_body[ls, 1], TUCK_LIFT)
+    reaches = model.tuck_reach[ls]  # the reaches the folded legs reach (init_crowd)
 
     def at(level):
         reach = reaches[:, level]
         ox, oz = _rot_xz(state.heading[cs], reach * (rest[:, 0] - model.hips_body[ls, 0]),
                          reach * (rest[:, 1] - model.hips_body[ls, 2]))
-        return np.column_stack([hip[:, 0] + ox, hip[:, 1] - (1.0 - TUCK_LIFT) * height, hip[:, 2] + oz])
+        return np.column_stack([hip[:, 0] + ox, hip[:, 1] - drop, hip[:, 2] + oz])
 
     points = at(0)
     if boxes is None or not len(boxes[0]):

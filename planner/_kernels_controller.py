@@ -322,6 +322,8 @@ def turns_into_bodies(centres, headings, turns, half_length, half_width, neighbo
     ``neighbour_start``, ``neighbour_index``; at the neighbour's heading before the turn) that it did not
     overlap before: :func:`moves_into_bodies` for a turn on the spot."""
     n = centres.shape[0]
+    # Two boxes further apart than twice their half diagonal cannot overlap at any headings.
+    apart = 4.0 * (half_length * half_length + half_width * half_width)
     for c in range(n):
         out[c] = False
         if turns[c] == 0.0:
@@ -333,6 +335,8 @@ def turns_into_bodies(centres, headings, turns, half_length, half_width, neighbo
             d = neighbour_index[a]
             bx = centres[d, 0]
             bz = centres[d, 1]
+            if (bx - ax) ** 2 + (bz - az) ** 2 >= apart:
+                continue
             if rects_overlap(ax, az, half_length, half_width, turned, bx, bz, half_length, half_width, headings[d]) \
                     and not rects_overlap(ax, az, half_length, half_width, headings[c], bx, bz, half_length, half_width,
                                           headings[d]):

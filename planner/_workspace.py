@@ -46,10 +46,10 @@ REACH_TOLERANCE = 1e-4
 _CACHE: dict = {}
 
 
-def _cached(kind: str, creature, rest_body, hips_body, legs, compute):
+def _cached(kind, creature, rest_body, hips_body, legs, compute):
     """Windows and steps depend only on the legs' geometry: computed once per geometry (each costs a
     few thousand IK solves), then shared by every crowd of that creature."""
-    key = (kind if isinstance(kind, str) else repr(kind), creature.name, float(creature.standing_height), np.asarray(creature.leg_reach).tobytes(),
+    key = (kind, creature.name, float(creature.standing_height), np.asarray(creature.leg_reach).tobytes(),
            rest_body.tobytes(), hips_body.tobytes(), legs.segment_lengths.tobytes(), legs.limits.tobytes(),
            legs.rest_azimuths.tobytes(), np.asarray(legs.azimuth_limits).tobytes(), legs.plane_rolls.tobytes())
     if key not in _CACHE:
@@ -315,6 +315,12 @@ def tuck_reaches(creature, rest_body: np.ndarray, hips_body: np.ndarray, legs, a
                    lambda: _tuck_reaches(creature, rest_body, hips_body, legs, asked, lift))
 
 
+def tuck_drop(creature, hips_up: np.ndarray, lift: float) -> np.ndarray:
+    """(L,) m a tucked foot is held below its hip: ``lift`` of the hip's height (``hips_up``, m above the
+    pelvis) above the ground, with the pelvis at the creature's standing height."""
+    return (1.0 - lift) * (float(creature.standing_height) + hips_up)
+
+
 TUCK_REACH_STEP = 0.05
 """Step (x the rest offset) in which :func:`tuck_reaches` moves an unreachable tuck point outwards."""
 
@@ -323,7 +329,7 @@ def _tuck_reaches(creature, rest_body, hips_body, legs, asked, lift) -> np.ndarr
     n_legs = rest_body.shape[0]
     grid = np.round(np.arange(0.0, 1.0 + 1e-9, TUCK_REACH_STEP), 10)
     k = grid.size
-    up = hips_body[:, 1] - (1.0 - lift) * (float(creature.standing_height) + hips_body[:, 1])
+    up = hips_body[:, 1] - tuck_drop(creature, hips_body[:, 1], lift)
     forward = hips_body[:, 0:1] + grid[None, :] * (rest_body[:, 0:1] - hips_body[:, 0:1])
     lateral = hips_body[:, 2:3] + grid[None, :] * (rest_body[:, 1:2] - hips_body[:, 2:3])
     targets = np.stack([forward, np.broadcast_to(up[:, None], forward.shape), lateral], axis=-1).reshape(-1, 3)
