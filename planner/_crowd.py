@@ -45,8 +45,10 @@ from footfall.planner._kernels_controller import (
     count_forbidden_landings,
     legs_crossed_by_turn,
     points_in_boxes,
+    push_out_of_boxes,
     stance_legs_crossing,
     stance_threatened,
+    swing_points,
     swings_invalidated,
     swings_meet_moving_boxes,
     uncrossed_turns,
@@ -491,11 +493,17 @@ def _planning_boxes(model: CrowdModel, state: CrowdState, boxes):
     """The boxes a foot is planned against: every box where it is now, and each moving box also where
     it will be ``threat_horizon`` from now (about a swing and the first frames of the stance that
     follows), so that a foot does not land where a crate is heading and is lifted again at once."""
+    return _boxes_also_at(model, boxes, state.t + model.controller.threat_horizon)
+
+
+def _boxes_also_at(model: CrowdModel, boxes, t: float):
+    """``boxes`` (as :func:`_boxes_now` or this gives them) and, appended, each of the scenario's moving
+    boxes where it is at time ``t``."""
     centres, sizes, yaws, forbidden, moving = boxes
-    if not moving.any():
+    m = np.flatnonzero(moving[:len(model.raster.obstacles.yaws)])
+    if not m.size:
         return boxes
-    later_centres, _, later_yaws, _, _ = _boxes_now(model, state.t + model.controller.threat_horizon)
-    m = np.flatnonzero(moving)
+    later_centres, _, later_yaws, _, _ = _boxes_now(model, t)
     return (np.ascontiguousarray(np.vstack([centres, later_centres[m]])), np.ascontiguousarray(np.vstack([sizes, sizes[m]])),
             np.ascontiguousarray(np.concatenate([yaws, later_yaws[m]])),
             np.ascontiguousarray(np.concatenate([forbidden, forbidden[m]])),
@@ -1941,7 +1949,9 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     """Plan every request, one kernel call per planning group (``groups`` and their ``maps``,
     :func:`map_groups`, :func:`stage_maps`; a far group's fallback is one more); apply the results.
     Returns (the batch of the one near group, or None, the results of every request, the requests'
-    characters, legs, every planning call as :class:`FramePlans` ``calls`` holds them)."""
+    characters, legs, every planning call as :class:`FramePlans` ``calls`` holds them). ``boxes``:
+    where they are now (:func:`_boxes_now`); the feet are planned against :func:`_planning_boxes`."""
+    planning = None if boxes is None else _planning_boxes(model, state, boxes)
     cs, ls = np.nonzero(kinds)
     f = cs.size
     n_legs = model.n_legs
@@ -2049,7 +2059,7 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
         couples_after_first=couples[cs], slice_size=slices[cs],
         # the paper's early termination (§5.2) always, unless a fixed budget says otherwise
         early=np.full(f, model.fixed_budget is None or model.fixed_budget.paper_early_stop, np.bool_))
-    out, calls = _plan_groups(model, state, request, cs, maps, groups, boxes)
+    out, calls = _plan_groups(model, state, request, cs, maps, groups, planning)
     batch = calls[0][0] if len(calls) == 1 and not groups[0][1] else None
     # Feet planned in the same frame do not see each other's targets: of two that would land within a
     # foot's room of each other, or two legs of one character whose ground lines would cross, the later
@@ -2108,6 +2118,13 @@ TUCK_FRAMES = 3
 of a swing (0.3 s) a crate closing at 0.3 m/s caught a spider's foot on its way in (crates-moving,
 12 spiders, 1200 frames, seed 3: 3 collisions, 0 with the flinch; over 20 other runs of 12 x 600
 frames the counts moved within their noise)."""
+TUCK_TURN_STEP = np.radians(5.0)
+"""rad: the steps in which a tucked foot with no clear tuck point is turned about its hip (:func:`tuck_points`)."""
+TUCK_TURNS = 6
+"""Steps of TUCK_TURN_STEP, either way, a tucked foot is turned at most (30 degrees)."""
+TUCK_CLEARANCE = 0.005
+"""m: how far past a box's side, beyond the foot's circumscribed radius, a tucked foot with no clear
+tuck point is pushed (:func:`tuck_points`)."""
 
 
 TUCK_REACHES = (TUCK_REACH, 0.15, 0.05)
@@ -2129,10 +2146,16 @@ lifting its foot half its hip's height, none at any reach, and keeps these."""
 def tuck_points(model: CrowdModel, state: CrowdState, cs, ls, hips, boxes=None) -> np.ndarray:
     """(F, 3) where foot ``ls`` of character ``cs`` is held when tucked: TUCK_REACH of its rest
     offset from its hip, on its own side (its leg crosses no other), TUCK_LIFT of the hip's height
-    above the ground under the hip. Where that point is inside one of ``boxes`` (as
-    :func:`_planning_boxes` gives them: where each is now and, a moving one, where it is heading),
-    the first of :data:`TUCK_REACHES` that is clear, else the last (each as far out as the leg reaches:
-    ``model.tuck_reach``)."""
+    above the ground under the hip. Where that point is inside one of ``boxes`` (where they are now,
+    :func:`_boxes_now`), or of the moving ones where they are one frame on (where the foot is judged
+    at the frame's end) or heading (:func:`_planning_boxes`), the first of :data:`TUCK_REACHES` that is
+    clear (each as far out as the leg reaches: ``model.tuck_reach``). Where none is and the last is in
+    a box now or one frame on, the last turned about the hip by the least of :data:`TUCK_TURNS` steps
+    of :data:`TUCK_TURN_STEP` either way that is clear; where none is, the last pushed out of those
+    boxes (:func:`push_out_of_boxes`, :data:`TUCK_CLEARANCE`). Why: an ant's folded legs reach no
+    nearer point than the first, and its body, turning away from a crate that followed it, swung the
+    tuck point of the leg on the crate's side into it (``mixed``, 64 ants, seed 1, character 29, frame
+    419, with the hysteresis of README session 52)."""
     from footfall.planner._workspace import tuck_drop
 
     rest = model.rest_body[ls] * state.feet_spacing[cs, None]
@@ -2149,22 +2172,41 @@ def tuck_points(model: CrowdModel, state: CrowdState, cs, ls, hips, boxes=None) 
     points = at(0)
     if boxes is None or not len(boxes[0]):
         return points
-    centres, sizes, yaws, forbidden, _ = boxes
+    near = _boxes_also_at(model, boxes, state.t + model.dt)
+    every = _boxes_also_at(model, near, state.t + model.controller.threat_horizon)
     hx, hz = 0.5 * model.creature.foot_length, 0.5 * model.creature.foot_width
     yaw = state.foot_yaws[cs, ls]
 
-    def inside(rows):
+    def inside(rows, boxes):
         out = np.empty(len(rows), np.bool_)
-        points_in_boxes(np.ascontiguousarray(points[rows]), hx, hz, np.ascontiguousarray(yaw[rows]), centres, sizes, yaws,
-                        forbidden, out)
+        points_in_boxes(np.ascontiguousarray(points[rows]), hx, hz, np.ascontiguousarray(yaw[rows]), *boxes[:4], out)
         return out
 
-    blocked = np.flatnonzero(inside(np.arange(len(cs))))
+    blocked = np.flatnonzero(inside(np.arange(len(cs)), every))
     for level in range(1, len(TUCK_REACHES)):
         if not blocked.size:
             break
         points[blocked] = at(level)[blocked]
-        blocked = blocked[inside(blocked)]
+        blocked = blocked[inside(blocked, every)]
+    blocked = blocked[inside(blocked, near)]
+    # Turned about the hip first, as far out: the leg reaches it where it reached the last. Pushed, a
+    # foot may come nearer the hip than an ant's folded leg reaches; the IK then draws it off its point,
+    # 2 cm into the crate (mixed, 64 ants, seed 2, character 34, frame 424, where no turn was clear).
+    base = points[blocked] - hip[blocked]
+    for k in range(1, TUCK_TURNS + 1):
+        for sign in (1.0, -1.0):
+            if not blocked.size:
+                break
+            ox, oz = _rot_xz(sign * k * TUCK_TURN_STEP, base[:, 0], base[:, 2])
+            points[blocked, 0] = hip[blocked, 0] + ox
+            points[blocked, 2] = hip[blocked, 2] + oz
+            still = inside(blocked, every)
+            points[blocked[still]] = hip[blocked[still]] + base[still]
+            blocked, base = blocked[still], base[still]
+    if blocked.size:
+        out = np.ascontiguousarray(points[blocked])
+        push_out_of_boxes(out, hx, hz, np.ascontiguousarray(yaw[blocked]), *near[:4], TUCK_CLEARANCE, 4)
+        points[blocked] = out
     return points
 
 
@@ -2174,7 +2216,8 @@ def tuck_swings(model: CrowdModel, state: CrowdState, cs, ls, hips, duration, bo
 
     The defined fallback for a stance foot a moving box will cover and that has no footprint: the
     body is no longer held by it (other legs may still hold it), and the foot looks for a
-    footprint every frame (``stage_requests``), landing as soon as it has one."""
+    footprint every frame (``stage_requests``), landing as soon as it has one. ``boxes``: where they
+    are now (:func:`_boxes_now`); a foot the path puts in one at the frame's end is held out of it."""
     target = tuck_points(model, state, cs, ls, hips, boxes)
     source = state.feet[cs, ls]
     u = np.linspace(0.0, 1.0, state.trajectories.shape[2])
@@ -2182,10 +2225,27 @@ def tuck_swings(model: CrowdModel, state: CrowdState, cs, ls, hips, duration, bo
     across = u * u * (3.0 - 2.0 * u)
     path = source[:, None, :] + across[None, :, None] * (target - source)[:, None, :]
     path[..., 1] = source[:, None, 1] + rise[None, :] * (target[:, None, 1] - source[:, None, 1])
+    duration = np.maximum(duration, TUCK_FRAMES * model.dt)
+    if boxes is not None and len(boxes[0]):
+        # Where the path puts the foot at the frame's end, in a box where it is then (the way in to the
+        # tuck point crosses the way of a crate): pushed out from there instead, and held. An ant's foot
+        # on its way in met the corner of the crate it fled (mixed, 64 ants, seed 5, character 34, frame 437).
+        then = np.empty((len(cs), 3))
+        swing_points(path, model.dt / duration, then)
+        near = _boxes_also_at(model, boxes, state.t + model.dt)
+        yaw = np.ascontiguousarray(state.foot_yaws[cs, ls])
+        hx, hz = 0.5 * model.creature.foot_length, 0.5 * model.creature.foot_width
+        blocked = np.empty(len(cs), np.bool_)
+        points_in_boxes(np.ascontiguousarray(then), hx, hz, yaw, *near[:4], blocked)
+        if blocked.any():
+            out = np.ascontiguousarray(then[blocked])
+            push_out_of_boxes(out, hx, hz, np.ascontiguousarray(yaw[blocked]), *near[:4], TUCK_CLEARANCE, 4)
+            path[blocked] = out[:, None, :]
+            target[blocked] = out
     state.trajectories[cs, ls] = path
     state.swing_target[cs, ls] = target
     state.swing_t[cs, ls] = 0.0
-    state.swing_T[cs, ls] = np.maximum(duration, TUCK_FRAMES * model.dt)
+    state.swing_T[cs, ls] = duration
     state.in_stance[cs, ls] = False
     state.wants_swing[cs, ls] = False
     state.tucked[cs, ls] = True
@@ -3009,7 +3069,7 @@ def step(model: CrowdModel, state: CrowdState) -> StepRecord:
         planning = _planning_boxes(model, state, boxes)
         maps = [stage_maps(model, state, group, planning, model.far_first if far else None) for group, far in groups]
         t5 = clock()
-        batch, out, cs, ls, calls = stage_plan(model, state, kinds, frequency, budgets, maps, groups, hips, planning)
+        batch, out, cs, ls, calls = stage_plan(model, state, kinds, frequency, budgets, maps, groups, hips, boxes)
         plans = FramePlans(cs, ls, kinds[cs, ls], out, batch, tuple(calls))
     else:
         t5 = clock()

@@ -46,6 +46,14 @@ def swing_point(path, u, d):
     return path[j, d] + a * (path[j + 1, d] - path[j, d])
 
 
+@nb.njit(cache=True)
+def swing_points(paths, u, out):
+    """Each foot's place at fraction ``u`` (F,) of its swing along ``paths`` (F, K, 3), into ``out`` (F, 3)."""
+    for f in range(paths.shape[0]):
+        for d in range(3):
+            out[f, d] = swing_point(paths[f], min(max(u[f], 0.0), 1.0), d)
+
+
 @nb.njit(cache=True, parallel=True)
 def advance_swings(swing_t, swing_T, trajectories, in_stance, feet, dt, out_landed):
     """Move every swinging foot along its trajectory at constant speed; flag landings."""
@@ -131,6 +139,41 @@ def points_in_boxes(points, foot_hx, foot_hz, foot_yaws, box_centres, box_sizes,
     for f in range(points.shape[0]):
         out[f] = foot_box_conflict(points[f, 0], points[f, 1], points[f, 2], foot_hx, foot_hz, foot_yaws[f], 0.0,
                                    box_centres, box_sizes, box_yaws, box_forbidden, every)
+
+
+@nb.njit(cache=True)
+def push_out_of_boxes(points, foot_hx, foot_hz, foot_yaws, box_centres, box_sizes, box_yaws, box_forbidden, clearance,
+                      rounds):
+    """Move each of ``points`` (F, 3), in place, out of the boxes its foot overlaps (as
+    :func:`points_in_boxes` counts them): across the box's nearest side, to the foot's circumscribed
+    radius plus ``clearance`` from it. ``rounds`` passes, as one pushed out of a box may land in
+    another; a point in a box after them is left where the last pass put it."""
+    n_boxes = box_centres.shape[0]
+    one = np.zeros(n_boxes, dtype=np.bool_)
+    radius = math.hypot(foot_hx, foot_hz) + clearance
+    for f in range(points.shape[0]):
+        for _ in range(rounds):
+            moved = False
+            for b in range(n_boxes):
+                one[b] = True
+                hit = foot_box_conflict(points[f, 0], points[f, 1], points[f, 2], foot_hx, foot_hz, foot_yaws[f], 0.0,
+                                        box_centres, box_sizes, box_yaws, box_forbidden, one)
+                one[b] = False
+                if not hit:
+                    continue
+                c, s = math.cos(box_yaws[b]), math.sin(box_yaws[b])
+                dx, dz = points[f, 0] - box_centres[b, 0], points[f, 2] - box_centres[b, 2]
+                lx, lz = c * dx + s * dz, -s * dx + c * dz
+                ex, ez = 0.5 * box_sizes[b, 0] + radius, 0.5 * box_sizes[b, 2] + radius
+                if ex - abs(lx) < ez - abs(lz):
+                    lx = math.copysign(ex, lx)
+                else:
+                    lz = math.copysign(ez, lz)
+                points[f, 0] = box_centres[b, 0] + c * lx - s * lz
+                points[f, 2] = box_centres[b, 2] + s * lx + c * lz
+                moved = True
+            if not moved:
+                break
 
 
 @nb.njit(cache=True, parallel=True)
