@@ -362,8 +362,10 @@ def moves_into_bodies(centres, headings, moves, half_length, half_width, neighbo
 def turns_into_bodies(centres, headings, turns, half_length, half_width, neighbour_start, neighbour_index, out):
     """Per character c, True when turning its body box (half extents ``half_length`` x ``half_width``
     along its heading, about its pelvis) by ``turns`` [c] makes it overlap a neighbour's (CSR
-    ``neighbour_start``, ``neighbour_index``; at the neighbour's heading before the turn) that it did not
-    overlap before: :func:`moves_into_bodies` for a turn on the spot."""
+    ``neighbour_start``, ``neighbour_index``) that it did not overlap before: :func:`moves_into_bodies`
+    for a turn on the spot. Characters are taken in order; a neighbour before c is seen at its heading
+    after its turn where that turn was let through, one after c at its heading before: of two bodies that
+    would turn into each other in one frame, the later is refused."""
     n = centres.shape[0]
     # Two boxes further apart than twice their half diagonal cannot overlap at any headings.
     apart = 4.0 * (half_length * half_length + half_width * half_width)
@@ -380,9 +382,12 @@ def turns_into_bodies(centres, headings, turns, half_length, half_width, neighbo
             bz = centres[d, 1]
             if (bx - ax) ** 2 + (bz - az) ** 2 >= apart:
                 continue
-            if rects_overlap(ax, az, half_length, half_width, turned, bx, bz, half_length, half_width, headings[d]) \
+            # A neighbour before it in order is seen turned, if its turn was let through: two bodies turning
+            # into each other in one frame, each turn clear of the other's old heading, overlapped.
+            hd = headings[d] + turns[d] if d < c and not out[d] else headings[d]
+            if rects_overlap(ax, az, half_length, half_width, turned, bx, bz, half_length, half_width, hd) \
                     and not rects_overlap(ax, az, half_length, half_width, headings[c], bx, bz, half_length, half_width,
-                                          headings[d]):
+                                          hd):
                 out[c] = True
                 break
 

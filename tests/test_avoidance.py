@@ -338,3 +338,17 @@ def test_bodies_already_overlapping_may_part_but_not_press_further():
     centres, headings = [[0.0, 0.0], [0.15, 0.0]], [0.0, 0.0]  # 5 cm into each other
     assert _moves_into(centres, headings, [[0.01, 0.0], [0.0, 0.0]]) == [True, False]
     assert _moves_into(centres, headings, [[-0.01, 0.0], [0.01, 0.0]]) == [False, False]
+
+
+def test_two_bodies_turning_into_each_other_in_one_frame_see_each_other_turned():
+    # The bodies of the test above, 2 cm of air between them. Turned 0.2 rad, body 0's front left corner
+    # goes to (0.1 cos 0.2 - 0.02 sin 0.2, 0.1 sin 0.2 + 0.02 cos 0.2) = (0.094, 0.0395); turned -0.2 rad,
+    # body 1's front right corner to (0.094, 0.06 - 0.0395) = (0.094, 0.0205). Each turn alone keeps clear
+    # of the other's body (0.0395 < 0.04, 0.0205 > 0.02); together the corners pass each other. The later
+    # one in order sees the earlier turned, and is refused.
+    centres, headings = [[0.0, 0.0], [0.0, 0.06]], [0.0, 0.0]
+    assert _turns_into(centres, headings, [0.2, 0.0]) == [False, False]
+    assert _turns_into(centres, headings, [0.0, -0.2]) == [False, False]
+    assert _turns_into(centres, headings, [0.2, -0.2]) == [False, True]
+    # An earlier turn that is itself refused is not seen: body 0 turning across (into body 1) stays put.
+    assert _turns_into(centres, headings, [math.pi / 2, -0.2]) == [True, False]
