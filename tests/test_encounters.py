@@ -558,7 +558,7 @@ def test_a_tuck_point_inside_a_box_moves_in_to_the_first_clear_one(tmp_path):
             return foot_box_conflict(*p, *half_foot, state.foot_yaws[0, leg], 0.0, *boxes[:4], np.ones(1, np.bool_))
 
         point = tuck_points(model, state, chars, legs, hips, boxes)
-        # Each foot at its first choice that does not touch the box (else the last).
+        # Each foot at its first choice that does not touch the box (here one always does).
         choices = [at(r) for r in TUCK_REACHES]
         chosen = [next((k for k in range(len(choices)) if not touches(choices[k][leg], leg)), len(choices) - 1)
                   for leg in legs]
