@@ -1945,13 +1945,17 @@ def _stamp_others(model: CrowdModel, state: CrowdState, chars: np.ndarray, forb,
                            0.5 * float(model.creature.foot_length))
 
 
-def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, maps, groups, hips, boxes=None):
+def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, maps, groups, hips, boxes=None,
+               planning=None):
     """Plan every request, one kernel call per planning group (``groups`` and their ``maps``,
     :func:`map_groups`, :func:`stage_maps`; a far group's fallback is one more); apply the results.
     Returns (the batch of the one near group, or None, the results of every request, the requests'
     characters, legs, every planning call as :class:`FramePlans` ``calls`` holds them). ``boxes``:
-    where they are now (:func:`_boxes_now`); the feet are planned against :func:`_planning_boxes`."""
-    planning = None if boxes is None else _planning_boxes(model, state, boxes)
+    where they are now (:func:`_boxes_now`); the feet are planned against ``planning``,
+    :func:`_planning_boxes` of them (computed here unless the caller, which built the maps against
+    them, passes them)."""
+    if planning is None and boxes is not None:
+        planning = _planning_boxes(model, state, boxes)
     cs, ls = np.nonzero(kinds)
     f = cs.size
     n_legs = model.n_legs
@@ -3069,7 +3073,8 @@ def step(model: CrowdModel, state: CrowdState) -> StepRecord:
         planning = _planning_boxes(model, state, boxes)
         maps = [stage_maps(model, state, group, planning, model.far_first if far else None) for group, far in groups]
         t5 = clock()
-        batch, out, cs, ls, calls = stage_plan(model, state, kinds, frequency, budgets, maps, groups, hips, boxes)
+        batch, out, cs, ls, calls = stage_plan(model, state, kinds, frequency, budgets, maps, groups, hips, boxes,
+                                               planning)
         plans = FramePlans(cs, ls, kinds[cs, ls], out, batch, tuple(calls))
     else:
         t5 = clock()
