@@ -416,6 +416,8 @@ class CrowdState:
     threatened: np.ndarray  # (C, L) bool: a moving box reaches the stance foot within the threat horizon
     tucked: np.ndarray  # (C, L) bool: a threatened foot with no footprint, held up near its hip (tuck_swings)
     escaping: np.ndarray  # (C,) bool: the last steer stage turned the character out of a moving box's lane
+    shoved: np.ndarray  # (C,) bool: the last steer stage moved the body by a shove (shove_out_of_moving_boxes)
+    shoved_onto_feet: np.ndarray  # (C, L) bool: a foot in the air the last shove carried onto another's foot (it re-plans)
     goal_speed: np.ndarray  # (C,) m/s: the speed the last steer stage headed for (0 at the goal; braking before it)
     speed_wanted: np.ndarray  # (C,) m/s: the speed the last steer stage asked after turns, avoidance and limits
     blocks_escape: np.ndarray  # (C, L) bool: a stance foot that stops an escaping character's turn
@@ -728,11 +730,19 @@ def shove_out_of_moving_boxes(model: CrowdModel, state: CrowdState, boxes, neigh
     frames 4 / 1 -> 9 / 0, stuck 90 / 103 -> 113 / 116 s); the crowds issue's bar sets (seeds 3000-3009
     and 4000-4009) and 1000 spiders (seeds 0-5) count the same as without it.
 
+    A tucked leg's hip keeps its innermost tuck point's distance from the box besides (2026-11-29): the
+    folded leg reaches no nearer point, and an ant's IK drew its tucked foot 1-3 cm into the crate in two
+    frames of the crowd bar (``mixed``, 64 ants, seed 2, character 34). Feet in the air that the shove
+    carried onto another character's foot plan again (:func:`_landings_shoved_onto_feet`); the shoved
+    characters are ``state.shoved``.
+
     A shoved body pushes the bodies it would run into (``neighbours``, CSR lists as :func:`_avoid` gives
     them) by the same move, and they theirs (:func:`_push_bodies`): shoved alone, an ant was pushed 6 cm
     into its neighbour's body over 10 frames (``mixed``, 64 ants, seed 3, character 19, frames 450-460,
     with the hysteresis on :func:`can_make_way` tried in session 52: README, crowds and moving boxes)."""
     centres, sizes, yaws, _, moving = boxes
+    state.shoved[:] = False
+    state.shoved_onto_feet[:] = False
     index = np.flatnonzero(moving)
     if not index.size:
         return
@@ -752,11 +762,16 @@ def shove_out_of_moving_boxes(model: CrowdModel, state: CrowdState, boxes, neigh
         if not air.size:
             continue
         yaw, centre = float(yaws[b]), centres[b, [0, 2]]
+        # A tucked leg's hip keeps its innermost tuck point's distance too: nearer, the folded leg reaches
+        # no point clear of the box, and the IK drew the foot 1-3 cm into it (mixed, 64 ants, seed 2,
+        # character 34, frames 424 and 430).
+        legs = np.arange(model.n_legs)
+        fold = np.where(state.tucked[c], np.hypot(*_tuck_offset(model, state.feet_spacing[c], legs,
+                                                                model.tuck_reach[:, -1])), 0.0)
         for _ in range(SHOVE_ROUNDS):
             hips = state.pelvis[c] + offsets[int(c)]
-            gap = min(min(_box_gap_out(state.feet[c, j, 0], state.feet[c, j, 2], centre, half[k], yaw)[0],
-                          _box_gap_out(hips[j, 0], hips[j, 2], centre, half[k], yaw)[0]) for j in air)
-            short = need - gap
+            short = max(need - min(_box_gap_out(state.feet[c, j, 0], state.feet[c, j, 2], centre, half[k], yaw)[0],
+                                   _box_gap_out(hips[j, 0], hips[j, 2], centre, half[k], yaw)[0] - fold[j]) for j in air)
             if short <= 0.0:
                 break
             push = short * _box_gap_out(state.pelvis[c, 0], state.pelvis[c, 2], centre, half[k], yaw)[1]
@@ -765,6 +780,29 @@ def shove_out_of_moving_boxes(model: CrowdModel, state: CrowdState, boxes, neigh
                 _push_bodies(model, state, int(c), push, neighbours)
             shoved[c] = True
     state.counters["shoves"] += int(shoved.sum())
+    state.shoved |= shoved
+    _landings_shoved_onto_feet(model, state)
+
+
+def _landings_shoved_onto_feet(model: CrowdModel, state: CrowdState) -> None:
+    """Mark (``state.shoved_onto_feet``) the feet in the air of shoved bodies whose landing spot, carried
+    along by the shove, is now within a foot's room (:func:`_foot_room`, the search's) of another character's
+    foot, where it stands or will land: they plan again (``stage_requests``). Re-planning every foot in
+    the air of a shoved body instead made the pelvis jump 8-9 cm (it follows the landing spots), against
+    2-3 cm (mixed, 64 ants, seeds 2 and 3)."""
+    from footfall.planner._kernels_geometry import points_near
+
+    state.shoved_onto_feet[:] = False
+    cs, ls = np.nonzero(state.shoved[:, None] & ~state.in_stance)
+    if not cs.size:
+        return
+    n_chars, n_legs = state.in_stance.shape
+    support = np.ascontiguousarray(_landing_feet(state)[..., [0, 2]].reshape(-1, 2))
+    owner = np.repeat(np.arange(n_chars), n_legs)
+    start, _ = points_near(support, owner, np.ascontiguousarray(state.swing_target[cs, ls][:, [0, 2]]),
+                           np.ascontiguousarray(cs, dtype=np.int64), _foot_room(model))
+    taken = np.diff(start) > 0
+    state.shoved_onto_feet[cs[taken], ls[taken]] = True
 
 
 def _move_body(state: CrowdState, c: int, move: np.ndarray) -> None:
@@ -800,6 +838,7 @@ def _push_bodies(model: CrowdModel, state: CrowdState, c: int, move: np.ndarray,
                                                     hx, hz, heading[j]):
                     continue
                 _move_body(state, j, move)
+                state.shoved[j] = True
                 xz[j] += move
                 pushed.add(j)
                 nxt.append(j)
@@ -1836,7 +1875,9 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, fre
     landing = state.swing_T - state.swing_t < 3.0 * model.dt
     respaced = np.abs(state.feet_spacing[:, None] - state.plan_spacing) > ctl.replan_spacing * state.plan_spacing
     # A tucked foot looks for a footprint every frame (the body moves on without it).
-    kinds[swinging & (((turned | sped | respaced) & ~landing) | invalid | state.tucked)] = 3
+    # So does a foot in the air a shove carried onto another character's foot, landing or not (shoved by
+    # the tuck distance, mixed, 64 ants, seed 2 had a foot spot shared with a neighbour in three frames).
+    kinds[swinging & (((turned | sped | respaced) & ~landing) | invalid | state.tucked | state.shoved_onto_feet)] = 3
     return kinds
 
 
@@ -2147,6 +2188,13 @@ kept clear of (``mixed``, 64 ants, seed 3). Spiders and 5-legged robots reach al
 lifting its foot half its hip's height, none at any reach, and keeps these."""
 
 
+def _tuck_offset(model: CrowdModel, spacing, ls, reach):
+    """(x, z) in the body frame (forward, left) of leg ``ls``'s tuck point from its hip: ``reach`` of its
+    rest foot's offset at feet spacing ``spacing`` (each broadcast against ``ls``)."""
+    return (reach * (model.rest_body[ls, 0] * spacing - model.hips_body[ls, 0]),
+            reach * (model.rest_body[ls, 1] * spacing - model.hips_body[ls, 2]))
+
+
 def tuck_points(model: CrowdModel, state: CrowdState, cs, ls, hips, boxes=None) -> np.ndarray:
     """(F, 3) where foot ``ls`` of character ``cs`` is held when tucked: TUCK_REACH of its rest
     offset from its hip, on its own side (its leg crosses no other), TUCK_LIFT of the hip's height
@@ -2162,15 +2210,12 @@ def tuck_points(model: CrowdModel, state: CrowdState, cs, ls, hips, boxes=None) 
     419, with the hysteresis of README session 52)."""
     from footfall.planner._workspace import tuck_drop
 
-    rest = model.rest_body[ls] * state.feet_spacing[cs, None]
     hip = hips[cs, ls]
     drop = tuck_drop(model.creature, model.hips_body[ls, 1], TUCK_LIFT)
     reaches = model.tuck_reach[ls]  # the reaches the folded legs reach (init_crowd)
 
     def at(level):
-        reach = reaches[:, level]
-        ox, oz = _rot_xz(state.heading[cs], reach * (rest[:, 0] - model.hips_body[ls, 0]),
-                         reach * (rest[:, 1] - model.hips_body[ls, 2]))
+        ox, oz = _rot_xz(state.heading[cs], *_tuck_offset(model, state.feet_spacing[cs], ls, reaches[:, level]))
         return np.column_stack([hip[:, 0] + ox, hip[:, 1] - drop, hip[:, 2] + oz])
 
     points = at(0)
@@ -2357,6 +2402,17 @@ def stage_pelvis(model: CrowdModel, state: CrowdState, smoothing: float | None =
     state.roll[moving] = roll[moving]
     state.pelvis_base[moving] = base[moving]
     state.pelvis_rise += y
+    # A tucked foot is held by its hip (tuck_points: a height above the ground under the hip, planned from
+    # the hips before this stage): it rises and falls with the body. Left where it was planned, a body
+    # falling 7 cm in a frame left it 4.5 cm above its hip, out of the folded leg's reach, and the IK drew
+    # it 1-1.1 cm into the crate beside it (mixed, 64 ants, seed 2, character 34, frames 411, 426, 441,
+    # while every foot in the air of a shoved body re-planned: see _landings_shoved_onto_feet).
+    cs, ls = np.nonzero(state.tucked & ~state.in_stance)
+    if cs.size:
+        rise = state.pelvis_rise[cs]
+        state.feet[cs, ls, 1] += rise
+        state.trajectories[cs, ls, :, 1] += rise[:, None]
+        state.swing_target[cs, ls, 1] += rise
 
 
 def stage_ik(model: CrowdModel, state: CrowdState, on_screen: np.ndarray) -> None:
@@ -2817,7 +2873,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         ik_on=np.zeros(n, np.bool_), fk_feet=feet.copy(), pelvis_base=np.zeros(n), pelvis_rise=np.zeros(n), body_held=np.zeros(n, np.bool_), speed_limit=np.full(n, np.inf), last_move=np.zeros((n, 2)), cannot_follow=np.zeros((n, L), np.bool_), unfollowed=np.zeros((n, L), np.bool_), pose_before=np.zeros((n, 7)),
         gait_index=gait_index, stride_frequency=np.zeros(n), turn_wanted=np.zeros(n), turn_left=np.zeros(n), turn_made=np.zeros(n),
         threatened=np.zeros((n, L), np.bool_), tucked=np.zeros((n, L), np.bool_),
-        escaping=np.zeros(n, np.bool_), goal_speed=np.full(n, speed), speed_wanted=np.zeros(n), blocks_escape=np.zeros((n, L), np.bool_), crossed=np.zeros((n, L, L), np.bool_),
+        escaping=np.zeros(n, np.bool_), shoved=np.zeros(n, np.bool_), shoved_onto_feet=np.zeros((n, L), np.bool_), goal_speed=np.full(n, speed), speed_wanted=np.zeros(n), blocks_escape=np.zeros((n, L), np.bool_), crossed=np.zeros((n, L, L), np.bool_),
         counters={k: 0 for k in ("steps", "plans", "holds", "replans", "forbidden_footprints", "cells_expanded",
                                  "couples_evaluated", "pose_takebacks", "crossing_takebacks", "map_cells_built", "ik_ccd_legs", "ik_two_bone_legs", "shoves",
                                  "boxed_ways")},
