@@ -1122,6 +1122,28 @@ def _lift_leg_1_behind_its_hip(state, hip):
     state.trajectories[0, 1, :, 0], state.trajectories[0, 1, :, 2] = hip[0] - 0.1, hip[2]
 
 
+def test_a_replan_that_turns_its_foot_into_a_box_where_it_is_waits():
+    # A re-plan turns a foot in the air to the plan's yaw where it is. The spider's foot (3 x 2 cm) in the
+    # air at (0.3, 0.05, 0.1); a forbidden box whose -z face is 1.2 cm beyond it. Along x (yaw 0) the foot
+    # reaches 1 cm across: clear; turned a quarter (yaw pi/2) it reaches 1.5 cm: into the box, and that
+    # re-plan waits. A new plan (a foot lifting, checked by its path) and a stance foot are not asked.
+    from footfall.planner._crowd import replans_turned_into_boxes
+
+    model, state, _ = _spider_standing_at_the_origin()
+    state.in_stance[0, 1] = False
+    state.feet[0, 1] = [0.3, 0.05, 0.1]
+    state.feet[0, 0] = [0.3, 0.0, 0.1]  # a stance foot at the same spot
+    box = (np.array([[0.3, 0.5, 0.1 + 0.012 + 0.1]]), np.array([[0.4, 1.0, 0.2]]), np.zeros(1),
+           np.ones(1, np.bool_), np.zeros(1, np.bool_))
+    cs, ls = np.zeros(4, np.int64), np.array([1, 1, 1, 0])
+    replans = np.array([True, True, False, True])
+    yaws = np.array([0.0, 0.5 * np.pi, 0.5 * np.pi, 0.5 * np.pi])
+    np.testing.assert_array_equal(replans_turned_into_boxes(model, state, cs, ls, replans, yaws, box),
+                                  [False, True, False, False])
+    no_boxes = tuple(a[:0] for a in box)
+    assert not replans_turned_into_boxes(model, state, cs, ls, replans, yaws, no_boxes).any()
+
+
 def test_a_moving_box_that_reaches_the_hip_of_a_leg_in_the_air_shoves_the_body_as_far():
     # The same spider, leg 1 in the air (its hip at x = 0.02 m), its foot tucked in 0.1 m behind that hip
     # (-x); a crate 0.2 m deep and 1 m wide whose -x face is 5 mm beyond that hip (+x). The foot is 0.105 m
