@@ -2113,7 +2113,8 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     ok &= ~paths_through_body(model, state, cs, ls, out.trajectory, ok)
     # A swing that meets a moving box on the way waits a frame (the box moves on); a foot whose swing
     # already does, its re-plan refused, is tucked (it went on into the box).
-    # A new swing turns the foot to its plan's yaw (assigned below), a current one keeps its own.
+    # Every plan let through turns its foot to the plan's yaw (assigned below), a re-plan where the foot is
+    # in the air; a refused re-plan's foot keeps its own yaw and path.
     ok &= ~swings_into_moving_boxes(model, state, cs, ls, out.trajectory, np.zeros(f), t_swing, ok, foot_yaw)
     ok &= ~replans_turned_into_boxes(model, state, cs, ls, ok & ~new, foot_yaw, boxes)
     meets = swings_into_moving_boxes(model, state, cs, ls, state.trajectories[cs, ls], state.swing_t[cs, ls],
