@@ -148,7 +148,7 @@ FIXED_RUNS = (0, 23)
 
 @pytest.mark.slow
 def test_runs_of_the_cell_are_reproduced_live():
-    """The first shipped preset's cell on its own terrain: some of its runs (a fixed one and two drawn
+    """The first shipped preset's cell on its own terrain: some of its runs (the fixed ones and two drawn
     for this session) run again now, under the defaults and under the preset, give the stored metrics
     exactly (the runs are deterministic), so the matrix is what the presets do now. They run in a
     process with numpy's CPU dispatch pinned (``tests/matrix_replay.py``), as the matrix was written."""
