@@ -2214,6 +2214,16 @@ def feet_in_boxes(model: CrowdModel, points, yaws, boxes) -> np.ndarray:
     return out
 
 
+def feet_pushed_out_of_boxes(model: CrowdModel, points, yaws, boxes) -> np.ndarray:
+    """(F, 3) ``points`` with each foot (turned by ``yaws``) that overlaps one of ``boxes`` moved out across
+    the box's nearest side, :data:`TUCK_CLEARANCE` past the foot's circumscribed radius
+    (:func:`planner._kernels_controller.push_out_of_boxes`, 4 passes)."""
+    out = np.array(points, dtype=np.float64, order="C")
+    push_out_of_boxes(out, 0.5 * model.creature.foot_length, 0.5 * model.creature.foot_width,
+                      np.ascontiguousarray(yaws, dtype=np.float64), *boxes[:4], TUCK_CLEARANCE, 4)
+    return out
+
+
 def _tuck_offset(model: CrowdModel, spacing, ls, reach):
     """(x, z) in the body frame (forward, left) of leg ``ls``'s tuck point from its hip: ``reach`` of its
     rest foot's offset at feet spacing ``spacing`` (each broadcast against ``ls``)."""
@@ -2249,7 +2259,6 @@ def tuck_points(model: CrowdModel, state: CrowdState, cs, ls, hips, boxes=None) 
         return points
     near = _boxes_also_at(model, boxes, state.t + model.dt)
     every = _boxes_also_at(model, near, state.t + model.controller.threat_horizon)
-    hx, hz = 0.5 * model.creature.foot_length, 0.5 * model.creature.foot_width
     yaw = state.foot_yaws[cs, ls]
 
     def inside(rows, boxes):
@@ -2277,9 +2286,7 @@ def tuck_points(model: CrowdModel, state: CrowdState, cs, ls, hips, boxes=None) 
             points[blocked[still]] = hip[blocked[still]] + base[still]
             blocked, base = blocked[still], base[still]
     if blocked.size:
-        out = np.ascontiguousarray(points[blocked])
-        push_out_of_boxes(out, hx, hz, np.ascontiguousarray(yaw[blocked]), *near[:4], TUCK_CLEARANCE, 4)
-        points[blocked] = out
+        points[blocked] = feet_pushed_out_of_boxes(model, points[blocked], yaw[blocked], near)
     return points
 
 
@@ -2306,12 +2313,10 @@ def tuck_swings(model: CrowdModel, state: CrowdState, cs, ls, hips, duration, bo
         then = np.empty((len(cs), 3))
         swing_points(path, model.dt / duration, then)
         near = _boxes_also_at(model, boxes, state.t + model.dt)
-        yaw = np.ascontiguousarray(state.foot_yaws[cs, ls])
-        hx, hz = 0.5 * model.creature.foot_length, 0.5 * model.creature.foot_width
+        yaw = state.foot_yaws[cs, ls]
         blocked = feet_in_boxes(model, then, yaw, near)
         if blocked.any():
-            out = np.ascontiguousarray(then[blocked])
-            push_out_of_boxes(out, hx, hz, np.ascontiguousarray(yaw[blocked]), *near[:4], TUCK_CLEARANCE, 4)
+            out = feet_pushed_out_of_boxes(model, then[blocked], yaw[blocked], near)
             path[blocked] = out[:, None, :]
             target[blocked] = out
     state.trajectories[cs, ls] = path
