@@ -2196,7 +2196,8 @@ def replans_turned_into_boxes(model: CrowdModel, state: CrowdState, cs, ls, repl
     :func:`_boxes_now` gives them): such a re-plan waits a frame, as one whose path meets a moving box
     does. A re-plan turns its foot in place; the path from there was checked, not the turn (a spider's
     foot turned 70 degrees beside a crate, into it: 1000 spiders, mixed, LOD on, seed 5, character 828,
-    frame 179)."""
+    frame 179). New swings are not asked: a foot lifting leaves the spot it stands on, which a box may
+    already reach (a threatened foot must lift)."""
     out = np.zeros(len(cs), np.bool_)
     turned = replans & ~state.in_stance[cs, ls]
     if turned.any() and len(boxes[0]):
