@@ -6,6 +6,7 @@ checks the promise on every frame with plain geometry written here (a point insi
 rectangle), beside the simulator's own counters.
 """
 
+import copy
 import math
 
 import numpy as np
@@ -629,6 +630,46 @@ def test_a_tucked_foot_rises_and_falls_with_its_body():
     others = np.arange(model.n_legs) != tucked
     np.testing.assert_array_equal(state.feet[0, others], before[0][0, others])
     np.testing.assert_array_equal(state.trajectories[0, free], before[1][0, free])
+
+
+def test_a_body_lowers_as_far_as_a_foot_landing_next_frame_needs_to_be_in_reach():
+    # Flat ground: the hull, and so the pelvis before the rule, do not depend on where on the ground a
+    # landing point lies. A foot in the air whose landing point lies 1 cm too low for its hip (its
+    # horizontal distance under the reach) lowers the body, when it lands within the next frame, until
+    # it is LANDING_REACH_MARGIN inside the reach; two frames before its landing, or with the point
+    # further across than the leg reaches, the body stays where the hull puts it.
+    from footfall.planner import _crowd as crowd
+    from footfall.planner._crowd import LANDING_REACH_MARGIN, hips_world
+
+    model, state = _ants_walked_a_second(1)
+    leg = int(np.flatnonzero(~state.in_stance[0] & ~state.tucked[0])[0])
+    reach = float(model.reach[leg])
+    dt = model.dt
+
+    def pelvis_after(target_across, frames_left):
+        s = copy.deepcopy(state)
+        s.swing_t[0, leg] = s.swing_T[0, leg] - frames_left * dt
+        hip = hips_world(model, s)[0, leg]
+        s.swing_target[0, leg] = [hip[0] + target_across, 0.0, hip[2]]
+        crowd.stage_pelvis(model, s, smoothing=1.0)
+        return s, float(np.linalg.norm(hips_world(model, s)[0, leg] - s.swing_target[0, leg]))
+
+    free, _ = pelvis_after(0.0, 0.0)
+    height = float(hips_world(model, free)[0, leg, 1])  # the hip above the ground, as the hull puts it
+    assert 0.01 < height < reach
+    across = math.sqrt(reach ** 2 - (height - 0.01) ** 2)
+    lowered, gap = pelvis_after(across, 1.0)
+    assert gap == pytest.approx(reach - LANDING_REACH_MARGIN, abs=1e-9)
+    drop = float(free.pelvis[0, 1] - lowered.pelvis[0, 1])
+    assert drop == pytest.approx(height - math.sqrt((reach - LANDING_REACH_MARGIN) ** 2 - across ** 2), abs=1e-9)
+    assert drop > 0.01
+    assert float(lowered.pelvis_rise[0]) == pytest.approx(float(free.pelvis_rise[0]) - drop, abs=1e-12)
+    assert lowered.counters["landing_drops"] == free.counters["landing_drops"] + 1
+    early, gap = pelvis_after(across, 3.0)
+    assert early.pelvis[0, 1] == free.pelvis[0, 1] and gap > reach
+    beyond, gap = pelvis_after(reach + 0.001, 1.0)
+    assert beyond.pelvis[0, 1] == free.pelvis[0, 1] and gap > reach
+    assert early.counters["landing_drops"] == beyond.counters["landing_drops"] == free.counters["landing_drops"]
 
 
 def _one_left_leg_tucked(tmp_path):
