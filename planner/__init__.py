@@ -5,12 +5,16 @@ numpy + numba only: this package never imports JAX, pyvista or pxr.
 """
 
 from footfall._numba_cache import warn_if_foreign_cache as _warn_if_foreign_cache
+from footfall.planner._allocator import keep_freed_memory as _keep_freed_memory
 from footfall.planner._threads import configure_worker_wait as _configure_worker_wait
 
 # numba's cache folder is the entry points' to set (footfall.configure_numba_cache), not the import's;
 # the import only warns when it was set by hand to a folder other sources may have filled.
 _warn_if_foreign_cache()
 _configure_worker_wait()
+# A frame's large arrays from memory the process keeps, not from fresh pages (planner._allocator; opt out with
+# FOOTFALL_KEEP_FREED_MEMORY=0).
+_keep_freed_memory()
 
 from footfall.planner._batch import BatchResult, FootBatch, make_batch, plan_batch  # noqa: E402
 from footfall.planner._crowd import (  # noqa: E402
