@@ -124,11 +124,11 @@ def shipped_presets() -> list[tuple[str, str, str]]:
     generic preset, or a terrain or style preset of ``tuning._matrix.PRESETS`` (read without JAX)."""
     from pathlib import Path
 
-    from footfall.tuning import PRESETS_DIR
+    from footfall.tuning import shipped_preset_paths
     from footfall.tuning._matrix import PRESETS
 
     rows = []
-    for path in sorted(PRESETS_DIR.glob("*.json")):
+    for path in shipped_preset_paths():
         spec = PRESETS.get(path.stem)
         if spec is None:
             creature = json.loads(path.read_text())["creature"]

@@ -11,11 +11,11 @@ def load_named_preset(value: str, creature: str):
 
     from footfall._errors import InputError
     from footfall.planner._presets import load_preset
-    from footfall.tuning import PRESETS_DIR  # no JAX: tuning's __init__ re-exports lazily
+    from footfall.tuning import PRESETS_DIR, shipped_preset_paths  # no JAX: tuning's __init__ re-exports lazily
 
     path = Path(value)
     if path.suffix != ".json" and len(path.parts) == 1 and not path.exists():
-        shipped = sorted(p.stem for p in PRESETS_DIR.glob("*.json"))
+        shipped = [p.stem for p in shipped_preset_paths()]
         if value not in shipped:
             raise InputError("argument", "--preset",
                              f"{value!r} is neither a .json file nor a shipped preset ({', '.join(shipped)})")

@@ -57,12 +57,10 @@ def _recorded(scenario_name: str, creature_name: str, characters: int, frames: i
 def golden() -> dict:
     from footfall.planner import load_preset
     from footfall.reports._sweep import PRESETS, build_tasks, run_task, without_timings
-    from footfall.tuning import PRESETS_DIR
+    from footfall.tuning import shipped_preset_paths
 
     result = {"recording": _recorded("crates-moving", "spider", 4, 60, 0, "on"), "presets": {}, "quality": {}}
-    for path in sorted(PRESETS_DIR.glob("*.json")):
-        if path.name.endswith(".checkpoint.json"):
-            continue
+    for path in shipped_preset_paths():
         preset = load_preset(path)
         result["presets"][path.stem] = {"file": hashlib.sha256(path.read_bytes()).hexdigest()[:16],
                                         "run": _recorded("mixed", preset.creature, 3, 40, 0, "off", preset)}

@@ -155,11 +155,11 @@ def test_scenarios_lists_descriptions_creatures_and_gaits():
     assert "8 legs" in out and "spider-metachronal-wave, then spider-alternating-tetrapod from Fr 0.2" in out
     assert "quadruped-trot" in out and "Diagonal pairs" in out
     # Every shipped preset, each with its creature and what it is for (its kind read from tuning._matrix).
-    from footfall.tuning import PRESETS_DIR
+    from footfall.tuning import shipped_preset_paths
     from footfall.tuning._matrix import PRESETS
 
     rows = {line.split()[0]: line.split(None, 2)[1:] for line in out.split("Presets (")[1].splitlines()[1:]}
-    shipped = {p.stem for p in PRESETS_DIR.glob("*.json")}
+    shipped = {p.stem for p in shipped_preset_paths()}
     assert set(rows) == shipped and {"spider", "spider-stairs"} <= shipped
     for name, (creature, what) in rows.items():
         spec = PRESETS.get(name)

@@ -48,8 +48,9 @@ def test_the_seeded_runs_and_the_report_columns_are_the_recorded_ones(computed):
 def test_the_golden_file_covers_every_shipped_preset_and_quality_row(computed):
     # A comparison of empty sections would pass anything: every part holds what it must.
     expected = json.loads(GOLDEN.read_text())
-    shipped = sorted(p.stem for p in (HERE.parent / "tuning" / "data" / "presets").glob("*.json")
-                     if not p.name.endswith(".checkpoint.json"))
+    from footfall.tuning import shipped_preset_paths
+
+    shipped = sorted(p.stem for p in shipped_preset_paths())
     # Every creature's generic preset ships (the terrain and style ones only while the matrix passes them).
     from footfall.scenarios import builtin_creature_names
 

@@ -70,3 +70,16 @@ def test_importing_tuning_for_its_presets_and_targets_does_not_load_jax():
             "assert 'jax' not in sys.modules, 'jax loaded'")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0, proc.stderr
+
+
+def test_a_tunes_checkpoint_beside_the_shipped_presets_is_not_one_of_them(tmp_path, monkeypatch):
+    # `footfall tune --out tuning/data/presets/NAME.json` leaves NAME.json.checkpoint.json beside it: it was
+    # read as a preset, and `footfall scenarios` stopped on it (KeyError: 'creature').
+    import footfall.tuning as tuning
+    from footfall.cli._commands import shipped_presets
+
+    (tmp_path / "spider.json").write_text(json.dumps({"creature": "spider"}))
+    (tmp_path / "spider.json.checkpoint.json").write_text(json.dumps({"format": "checkpoint"}))
+    monkeypatch.setattr(tuning, "PRESETS_DIR", tmp_path)
+    assert [p.name for p in tuning.shipped_preset_paths()] == ["spider.json"]
+    assert [row[:2] for row in shipped_presets()] == [("spider", "spider")]

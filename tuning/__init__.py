@@ -30,6 +30,13 @@ from pathlib import Path
 PRESETS_DIR = Path(__file__).resolve().parent / "data" / "presets"
 """The shipped, tuned presets (``footfall simulate --preset spider`` or ``--preset FILE``)."""
 
+
+def shipped_preset_paths() -> list[Path]:
+    """The preset files in :data:`PRESETS_DIR`, by name: every ``*.json`` but a tune's checkpoints
+    (``NAME.json.checkpoint.json``, written beside a preset tuned into that folder)."""
+    return sorted(p for p in PRESETS_DIR.glob("*.json") if not p.name.endswith(".checkpoint.json"))
+
+
 # Lazy re-exports (PEP 562): ``import tuning`` and the JAX-free modules (``tuning._targets``)
 # must not load JAX, so that the report and the CLI can read the targets and the shipped
 # presets without it. A name is imported from its module on first use.
@@ -59,4 +66,4 @@ def __dir__():
     return sorted(set(globals()) | set(_EXPORTS))
 
 
-__all__ = ["PRESETS_DIR", *_EXPORTS]
+__all__ = ["PRESETS_DIR", "shipped_preset_paths", *_EXPORTS]
