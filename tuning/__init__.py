@@ -33,7 +33,22 @@ PRESETS_DIR = Path(__file__).resolve().parent / "data" / "presets"
 
 def shipped_preset_paths() -> list[Path]:
     """The preset files in :data:`PRESETS_DIR`, by name: every ``*.json`` but a tune's checkpoints
-    (``NAME.json.checkpoint.json``, written beside a preset tuned into that folder)."""
+    (``NAME.json.checkpoint.json``, written beside a preset tuned into that folder).
+
+    Returns
+    -------
+    list of Path
+        Sorted by file name.
+
+    Examples
+    --------
+    >>> from footfall.tuning import shipped_preset_paths
+    >>> names = [path.stem for path in shipped_preset_paths()]
+    >>> {"spider", "quadruped", "spider-stairs"} <= set(names)
+    True
+    >>> any(name.endswith(".checkpoint") for name in names)
+    False
+    """
     return sorted(p for p in PRESETS_DIR.glob("*.json") if not p.name.endswith(".checkpoint.json"))
 
 
