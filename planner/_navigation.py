@@ -214,6 +214,14 @@ def _clear(ax, az, bx, bz, centres, half, cos_yaw, sin_yaw, clearance, own_a, ow
         hz = half[k, 1]
         c = cos_yaw[k]
         s = sin_yaw[k]
+        # A box whose bounding rectangle (x, z) the segment's misses is not entered: skipped before the
+        # exact test (the same answers; most boxes of a scene are far from a given segment). A stretch
+        # inside the box lies within ex, ez of its centre; 1e-9 m keeps round-off out of the question.
+        ex = abs(c) * hx + abs(s) * hz
+        ez = abs(s) * hx + abs(c) * hz
+        if (max(ax, bx) < cx - ex - 1e-9 or min(ax, bx) > cx + ex + 1e-9 or max(az, bz) < cz - ez - 1e-9
+                or min(az, bz) > cz + ez + 1e-9):
+            continue
         grow = clearance
         if own_a and _inside(ax, az, cx, cz, hx, hz, c, s):
             grow = min(grow, body, _depth_margin(ax, az, cx, cz, hx, hz, c, s, clearance) - NODE_EPS)
