@@ -15,7 +15,7 @@ def load_named_preset(value: str, creature: str):
 
     path = Path(value)
     if path.suffix != ".json" and len(path.parts) == 1 and not path.exists():
-        shipped = [p.stem for p in shipped_preset_paths()]
+        shipped = sorted(p.stem for p in shipped_preset_paths())
         if value not in shipped:
             raise InputError("argument", "--preset",
                              f"{value!r} is neither a .json file nor a shipped preset ({', '.join(shipped)})")

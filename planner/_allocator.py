@@ -10,8 +10,8 @@ process (``mallopt``: a high ``M_MMAP_THRESHOLD``, so such arrays come from the 
 ``M_TRIM_THRESHOLD``, so the heap keeps what is freed) takes them to 1 a frame: 1000 spiders, LOD
 on, a program that only steps the crowd, 50-56 -> 45-46 ms per frame (the same runs, alternating;
 README, Measured). ``footfall simulate`` gains less (a few %): its per-frame metrics keep part of that
-memory in use anyway. Results do not depend on it. The price is memory: the process keeps its largest frame's worth of arrays after they
-are freed.
+memory in use anyway. Results do not depend on it. The price is memory: the process keeps its largest
+frame's worth of arrays after they are freed.
 
 Only glibc (Linux) has these settings; elsewhere, or with ``FOOTFALL_KEEP_FREED_MEMORY=0``, nothing
 changes.
