@@ -1,5 +1,6 @@
 """planner._allocator: after importing the planner, arrays freed and allocated again cost no page faults."""
 
+import os
 import subprocess
 import sys
 
@@ -25,8 +26,6 @@ print(resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before, keep_freed_me
 
 
 def _faults(env_value: str) -> tuple[int, bool]:
-    import os
-
     env = dict(os.environ, FOOTFALL_KEEP_FREED_MEMORY=env_value)
     out = subprocess.run([sys.executable, "-c", PROBE], env=env, capture_output=True, text=True, check=True)
     faults, applied = out.stdout.split()

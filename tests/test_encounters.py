@@ -636,7 +636,7 @@ def test_a_body_lowers_as_far_as_a_foot_landing_next_frame_needs_to_be_in_reach(
     # Flat ground: the hull, and so the pelvis before the rule, do not depend on where on the ground a
     # landing point lies. A foot in the air whose landing point lies 1 cm too low for its hip (its
     # horizontal distance under the reach) lowers the body, when it lands within the next frame, until
-    # it is LANDING_REACH_MARGIN inside the reach; two frames before its landing, or with the point
+    # it is LANDING_REACH_MARGIN inside the reach; three frames before its landing, or with the point
     # further across than the leg reaches, the body stays where the hull puts it.
     from footfall.planner import _crowd as crowd
     from footfall.planner._crowd import LANDING_REACH_MARGIN, hips_world
