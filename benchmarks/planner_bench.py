@@ -76,12 +76,12 @@ def _wavefront_grids(maps, requests, weights, config):
         code, elev_dil, boxh, raw, r0, c0, hp, wp = prepare_foot(
             m.elevation, m.ground, m.forbidden, m.frame.origin_x, m.frame.origin_z, cell, offsets, q.source[0],
             q.source[2], q.preferred[0], q.preferred[1], config.search_radius_m, config.roi_margin_cells,
-            q.other_legs, q.feet_block_radius)
+            q.kernel_legs, q.feet_block_radius)
         sr, sc = m.frame.world_to_cell(q.source[0], q.source[2])
         source = int((sr - r0 + 1) * wp + (sc - c0 + 1))
         cands = footprint_candidates(code, elev_dil, raw, r0, c0, hp, wp, m.frame.origin_x, m.frame.origin_z, cell,
                                      source, q.source[0], q.source[2], q.preferred[0], q.preferred[1],
-                                     config.search_radius_m, q.hip[0], q.hip[1], q.reach_xz, q.other_legs,
+                                     config.search_radius_m, q.hip[0], q.hip[1], q.reach_xz, q.kernel_legs,
                                      q.feet_block_radius, w)[0]
         if cands.size == 0:
             continue

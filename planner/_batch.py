@@ -12,6 +12,7 @@ from footfall.planner._maps import LocalMaps
 from footfall.planner._params import DEFAULT_BUDGET, PlannerConfig, SearchBudget
 from footfall.planner._search import MODES, FootQuery
 from footfall.planner._weights import N_TERMS, ScoringWeights
+from footfall.planner.layout import N_LEG_COLUMNS
 
 
 @dataclass(frozen=True)
@@ -40,8 +41,9 @@ class FootBatch:
         Each leg's horizontal reach, its preferred step height and the room other feet leave
         the foot (:attr:`FootQuery.feet_block_radius`), m.
     legs, legs_start : ndarray
-        The other legs of every foot, rows (hip_x, hip_z, foot_x, foot_z), shape (sum M, 4);
-        foot i's are rows ``legs_start[i]:legs_start[i + 1]`` (shape (F + 1,)).
+        The legs every foot keeps clear of, rows ``planner.layout.LEG_ROW`` (x, z to x, z, and 1.0
+        when a foot ends the row: :attr:`FootQuery.kernel_legs`), shape (sum M, 5); foot i's are rows
+        ``legs_start[i]:legs_start[i + 1]`` (shape (F + 1,)).
     couples_after_first, slice_size, early : ndarray, shape (F,)
         Each foot's search budget (:meth:`SearchBudget.kernel_args`): couples after the first
         valid one (-1 = unlimited), slice size in m (-1 = no slices), the paper's early stop.
@@ -70,7 +72,7 @@ class FootBatch:
     hips: np.ndarray  # (F, 2)
     reach_xz: np.ndarray  # (F,)
     step_height: np.ndarray  # (F,)
-    legs: np.ndarray  # (sum M, 4)
+    legs: np.ndarray  # (sum M, 5) planner.layout.LEG_ROW
     legs_start: np.ndarray  # (F + 1,)
     block_radius: np.ndarray  # (F,)
     couples_after_first: np.ndarray  # (F,) int, -1 = unlimited
@@ -184,7 +186,7 @@ def make_batch(maps: list[LocalMaps], requests: list[tuple[int, FootQuery]],
         budgets = [budgets] * n
     if len(budgets) != n:
         raise ValueError(f"budgets: expected {n} budgets, got {len(budgets)}")
-    legs = [q.other_legs for _, q in requests]
+    legs = [q.kernel_legs for _, q in requests]
     starts = np.zeros(n + 1, dtype=np.int64)
     starts[1:] = np.cumsum([len(a) for a in legs])
     args = [b.kernel_args() for b in budgets]
@@ -202,7 +204,7 @@ def make_batch(maps: list[LocalMaps], requests: list[tuple[int, FootQuery]],
         hips=np.array([q.hip for _, q in requests], dtype=np.float64).reshape(n, 2),
         reach_xz=np.array([q.reach_xz for _, q in requests], dtype=np.float64),
         step_height=np.array([q.step_height for _, q in requests], dtype=np.float64),
-        legs=np.ascontiguousarray(np.concatenate(legs) if n else np.zeros((0, 4))).reshape(-1, 4),
+        legs=np.ascontiguousarray(np.concatenate(legs) if n else np.zeros((0, N_LEG_COLUMNS))).reshape(-1, N_LEG_COLUMNS),
         legs_start=starts,
         block_radius=np.array([q.feet_block_radius for _, q in requests], dtype=np.float64),
         couples_after_first=np.array([a[0] for a in args], dtype=np.int64),

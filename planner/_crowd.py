@@ -53,6 +53,7 @@ from footfall.planner._kernels_controller import (
     swings_meet_moving_boxes,
     uncrossed_turns,
 )
+from footfall.planner._kernels_geometry import bowed_legs_onto_lines
 from footfall.planner._kernels_maps import build_local_maps
 from footfall.planner._lod import (
     FULL_SEARCH,
@@ -69,7 +70,7 @@ from footfall.planner._maps import WorldRaster
 from footfall.planner._params import PlannerConfig, SearchBudget
 from footfall.planner._timing import stance_lead
 from footfall.planner._weights import ScoringWeights
-from footfall.planner.layout import CNT_BOXED, CNT_COUPLES_3D, CNT_EXPANDED
+from footfall.planner.layout import CNT_BOXED, CNT_COUPLES_3D, CNT_EXPANDED, LEG_FOOT, N_LEG_COLUMNS
 
 DT = 1.0 / 30.0
 ESCAPE_FROUDE = 0.5
@@ -426,6 +427,7 @@ class CrowdState:
     lod_level: np.ndarray | None = None  # (C,) int8: each character's level of detail (planner._lod, LEVEL_*)
     near_moving_box: np.ndarray | None = None  # (C,) bool: a moving box is near: it plans as a near character
     aim_node: np.ndarray | None = None  # (C,) int: the corner of the way round static boxes aimed at (-1: none)
+    drawn_legs: np.ndarray | None = None  # (C, L, P, 3) the legs as drawn when this frame's requests were made
 
 
 def hips_world(model: CrowdModel, state: CrowdState) -> np.ndarray:
@@ -1651,11 +1653,49 @@ def _same_character_pairs(cs, idx) -> tuple[np.ndarray, np.ndarray]:
     return np.minimum(a, b), np.maximum(a, b)
 
 
-def _with_neighbours_feet(model: CrowdModel, state: CrowdState, cs, own, preferred, support):
-    """(legs (M, 4), legs_start (F + 1,)): each planned foot's other legs (``own``, hip -> foot
-    segments of its character) followed by the feet of other characters near its preferred footprint,
-    as zero-length legs (x, z, x, z): where they stand, or, swinging, where they will land
-    (``support``, :func:`_landing_feet` of this state).
+DRAWN_LEG_TOLERANCE_M = 0.002
+"""A leg as drawn whose ground projection leaves its straight hip -> foot line by more than this is
+kept clear of as drawn too (:func:`drawn_leg_segments`). A body pitched on a stair tilts its legs'
+planes: a spider's knee was drawn 4 cm off that line, a landing clear of the line landed across the
+knee (``stairs@terrain.rise=0.1,terrain.run=0.3``, seed 502, frames 6-7, legs 1 and 2)."""
+
+
+def drawn_leg_segments(drawn, chars, legs, straight):
+    """(rows (R, 5), start (F + 1,)): per planned foot, its other legs as drawn, where they leave a
+    straight line: ``planner.layout.LEG_ROW`` rows that end in no foot.
+
+    ``drawn`` (C, L, P, 3): the legs as drawn (:func:`rendered_joints`, hip first, foot last);
+    ``chars`` (F,), ``legs`` (F, K): each planned foot's character and other legs; ``straight``
+    (F, K, 4): the lines hip -> foot those legs are kept clear of at touchdown. A leg whose knees
+    leave the segment between its drawn hip and foot by more than :data:`DRAWN_LEG_TOLERANCE_M`
+    (a tilted body's legs; a quadruped's knee before or behind its hip) is moved onto its line: its
+    hip to the line's hip, its foot to the line's foot, each knee by a blend of the two moves (its
+    share of the leg's length from the hip), so its shape is carried, not scaled. A leg drawn along
+    its line adds none (on flat ground, a spider's or an ant's).
+
+    >>> drawn = np.zeros((1, 3, 3, 3))
+    >>> drawn[0, 1, :, [0, 2]] = [[0.0, 0.05, 0.1], [0.0, 0.02, 0.0]]   # leg 1: its knee bows 2 cm
+    >>> drawn[0, 2, :, 0] = [0.0, 0.05, 0.1]                            # leg 2: straight
+    >>> straight = np.array([[[0.0, 1.0, 0.1, 1.0], [0.0, 0.0, 0.1, 0.0]]])  # leg 1 a metre on
+    >>> rows, start = drawn_leg_segments(drawn, np.array([0]), np.array([[1, 2]]), straight)
+    >>> rows.round(12).tolist(), start.tolist()     # leg 1's two segments, carried onto its line
+    ([[0.0, 1.0, 0.05, 1.02, 0.0], [0.05, 1.02, 0.1, 1.0, 0.0]], [0, 2])
+    """
+    return bowed_legs_onto_lines(np.ascontiguousarray(drawn, dtype=np.float64), np.asarray(chars, dtype=np.int64),
+                                 np.ascontiguousarray(legs, dtype=np.int64),
+                                 np.ascontiguousarray(straight, dtype=np.float64), DRAWN_LEG_TOLERANCE_M,
+                                 N_LEG_COLUMNS)
+
+
+def _with_neighbours_feet(model: CrowdModel, state: CrowdState, cs, own, drawn_rows, drawn_start, preferred,
+                          support):
+    """(legs (M, 5), legs_start (F + 1,)): each planned foot's other legs (``own`` (F, K, 4), hip ->
+    foot segments of its character), the feet of other characters near its preferred footprint, as
+    zero-length legs (x, z, x, z): where they stand, or, swinging, where they will land
+    (``support``, :func:`_landing_feet` of this state), then the segments of its other legs as
+    drawn (``drawn_rows``, CSR by ``drawn_start``, :func:`drawn_leg_segments`). Rows are
+    ``planner.layout.LEG_ROW``, those that end in a foot first: the order of
+    :attr:`FootQuery.kernel_legs`, so a request rebuilt as a query plans the same.
 
     The search keeps a foot's room (``block_radius``) from every foot in the list, so a foot never lands
     on another character's foot (``shared_foot_spots``); a neighbour's foot also lowers the leg-spacing
@@ -1663,28 +1703,41 @@ def _with_neighbours_feet(model: CrowdModel, state: CrowdState, cs, own, preferr
     ``others_in_maps`` option) blocked 20-30 cm around every foot and broke strides in crowds."""
     f, k = own.shape[0], own.shape[1]
     n_chars, n_legs = state.in_stance.shape
+    n_drawn = np.diff(drawn_start)
     if not model.controller.avoid_others_feet or n_chars < 2 or f == 0:
-        return np.ascontiguousarray(own.reshape(-1, 4)), np.arange(f + 1, dtype=np.int64) * k
-    from footfall.planner._kernels_geometry import points_near
+        near = np.zeros(0, dtype=np.int64)
+        counts = np.zeros(f, dtype=np.int64)
+    else:
+        from footfall.planner._kernels_geometry import points_near
 
-    support = np.ascontiguousarray(support[..., [0, 2]].reshape(-1, 2))
-    owner = np.repeat(np.arange(n_chars), n_legs)
-    radius = model.config.search_radius_m + 2.0 * _foot_room(model)
-    # The other characters' feet only, ascending (a grid kernel: the k-d tree's lists of lists cost
-    # 3.4 ms a frame for 1000 spiders).
-    found_start, near = points_near(support, owner, np.ascontiguousarray(preferred, dtype=np.float64),
-                                    np.ascontiguousarray(cs, dtype=np.int64), radius)
-    counts = np.diff(found_start)
-    foot_of = np.repeat(np.arange(f), counts)
+        owner = np.repeat(np.arange(n_chars), n_legs)
+        radius = model.config.search_radius_m + 2.0 * _foot_room(model)
+        # The other characters' feet only, ascending (a grid kernel: the k-d tree's lists of lists cost
+        # 3.4 ms a frame for 1000 spiders).
+        found_start, near = points_near(np.ascontiguousarray(support[..., [0, 2]].reshape(-1, 2)), owner,
+                                        np.ascontiguousarray(preferred, dtype=np.float64),
+                                        np.ascontiguousarray(cs, dtype=np.int64), radius)
+        counts = np.diff(found_start)
     legs_start = np.zeros(f + 1, dtype=np.int64)
-    np.cumsum(k + counts, out=legs_start[1:])
-    legs = np.empty((legs_start[-1], 4))
-    legs[(legs_start[:-1, None] + np.arange(k)).ravel()] = own.reshape(-1, 4)
-    first = np.zeros(f, dtype=np.int64)
-    np.cumsum(counts[:-1], out=first[1:])
-    rows = legs_start[foot_of] + k + (np.arange(near.size) - first[foot_of])
-    legs[rows] = support[near][:, [0, 1, 0, 1]]
+    np.cumsum(k + n_drawn + counts, out=legs_start[1:])
+    legs = np.zeros((legs_start[-1], N_LEG_COLUMNS))
+    mine = (legs_start[:-1, None] + np.arange(k)).ravel()
+    legs[mine, :4] = own.reshape(-1, 4)
+    legs[mine, LEG_FOOT] = 1.0
+    if near.size:
+        rows = _csr_rows(legs_start[:-1] + k, counts)
+        legs[rows, :4] = support[..., [0, 2]].reshape(-1, 2)[near][:, [0, 1, 0, 1]]
+        legs[rows, LEG_FOOT] = 1.0
+    legs[_csr_rows(legs_start[:-1] + k + counts, n_drawn)] = drawn_rows
     return legs, legs_start
+
+
+def _csr_rows(first, counts) -> np.ndarray:
+    """The rows ``first[i] .. first[i] + counts[i] - 1`` of every i, in order."""
+    total = int(counts.sum())
+    before = np.zeros(counts.size, dtype=np.int64)
+    np.cumsum(counts[:-1], out=before[1:])
+    return np.repeat(first - before, counts) + np.arange(total)
 
 
 def _solve_feet(model: CrowdModel, state: CrowdState, cs, ls, hips, iterations: int, restarts: int,
@@ -1813,7 +1866,9 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, fre
     far |= turn_crossed_legs(model, state, state.turn_wanted)
     # A stance foot the body turned across another leg steps (its own side again).
     crossing = np.empty(state.in_stance.shape, dtype=np.bool_)
-    stance_legs_crossing(np.ascontiguousarray(rendered_joints(model, state, hips)), state.in_stance, crossing)
+    # The legs as drawn at this frame's hips: the planning stage keeps landings off them (stage_plan).
+    state.drawn_legs = np.ascontiguousarray(rendered_joints(model, state, hips))
+    stance_legs_crossing(state.drawn_legs, state.in_stance, crossing)
     far |= crossing
     centres, sizes, yaws, forbidden, moving = boxes
     threatened = np.zeros(state.in_stance.shape, dtype=np.bool_)
@@ -1987,14 +2042,15 @@ def _stamp_others(model: CrowdModel, state: CrowdState, chars: np.ndarray, forb,
 
 
 def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, maps, groups, hips, boxes=None,
-               planning=None):
+               planning=None, drawn=None):
     """Plan every request, one kernel call per planning group (``groups`` and their ``maps``,
     :func:`map_groups`, :func:`stage_maps`; a far group's fallback is one more); apply the results.
     Returns (the batch of the one near group, or None, the results of every request, the requests'
     characters, legs, every planning call as :class:`FramePlans` ``calls`` holds them). ``boxes``:
     where they are now (:func:`_boxes_now`); the feet are planned against ``planning``,
     :func:`_planning_boxes` of them (computed here unless the caller, which built the maps against
-    them, passes them)."""
+    them, passes them). ``drawn``: the legs as drawn at ``hips`` (:func:`rendered_joints`; computed
+    here unless the caller has them)."""
     if planning is None and boxes is not None:
         planning = _planning_boxes(model, state, boxes)
     cs, ls = np.nonzero(kinds)
@@ -2090,7 +2146,10 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
     later = np.stack([hx, hz, support[cs[:, None], oj, 0], support[cs[:, None], oj, 2]], axis=-1)
     now = np.stack([hx, hz, state.feet[cs[:, None], oj, 0], state.feet[cs[:, None], oj, 2]], axis=-1)
     own = np.concatenate([later, now], axis=1)  # (F, 2 (L - 1), 4)
-    legs, legs_start = _with_neighbours_feet(model, state, cs, own, preferred, support)
+    if drawn is None:
+        drawn = rendered_joints(model, state, hips)
+    drawn_rows, drawn_start = drawn_leg_segments(drawn, cs, oj, now)
+    legs, legs_start = _with_neighbours_feet(model, state, cs, own, drawn_rows, drawn_start, preferred, support)
     couples, slices, _ = budgets
     request = FootBatch(
         elevation=None, ground=None, forbidden=None, origins=None, foot_char=None,
@@ -3189,7 +3248,7 @@ def step(model: CrowdModel, state: CrowdState) -> StepRecord:
         maps = [stage_maps(model, state, group, planning, model.far_first if far else None) for group, far in groups]
         t5 = clock()
         batch, out, cs, ls, calls = stage_plan(model, state, kinds, frequency, budgets, maps, groups, hips, boxes,
-                                               planning)
+                                               planning, state.drawn_legs)
         plans = FramePlans(cs, ls, kinds[cs, ls], out, batch, tuple(calls))
     else:
         t5 = clock()

@@ -7,11 +7,11 @@ from __future__ import annotations
 import numpy as np
 
 from footfall.planner._kernels_foot import footprint_features
-from footfall.planner.layout import FEAT_ROUGHNESS, FEAT_SLOPE, N_FEATURES
+from footfall.planner.layout import FEAT_ROUGHNESS, FEAT_SLOPE, N_FEATURES, N_LEG_COLUMNS
 
 _CENTRE = 4
 """The foot's cell in its 3 x 3 neighbourhood, flattened row by row (z, then x)."""
-_NO_LEGS = np.zeros((0, 4))
+_NO_LEGS = np.zeros((0, N_LEG_COLUMNS))  # planner.layout.LEG_ROW rows: none
 
 
 def ground_under_feet(terrain, feet_xz: np.ndarray, spacing: float) -> tuple[np.ndarray, np.ndarray]:

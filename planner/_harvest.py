@@ -153,7 +153,7 @@ def harvest_foot(maps: LocalMaps, query: FootQuery, weights: ScoringWeights | No
     _, slice_size, _ = budget.kernel_args()
     return _harvest_kernel_call(maps.elevation, maps.ground, maps.forbidden, maps.frame.origin_x, maps.frame.origin_z,
                                 foot_shape, query.source, query.preferred, query.hip, float(query.reach_xz),
-                                float(query.step_height), query.other_legs, query.feet_block_radius,
+                                float(query.step_height), query.kernel_legs, query.feet_block_radius,
                                 weights.to_array(), config.to_array(), slice_size)
 
 

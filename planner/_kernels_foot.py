@@ -58,6 +58,7 @@ from footfall.planner.layout import (  # noqa: F401  (re-exported: the kernels' 
     FEAT_ROUGHNESS,
     FEAT_SLOPE,
     FORBIDDEN_MOVING,
+    LEG_FOOT,
     N_COUNTERS,
     N_FEATURES,
     N_RAW,
@@ -194,6 +195,8 @@ def prepare_foot(elevation, ground, forbidden, origin_x, origin_z, cell, offsets
                 # A size-increase cell stays one: it is no footprint, and it seeds the proximity term.
                 if code[p] == FREE:
                     code[p] = OTHER_LEG
+        if other_legs[j, LEG_FOOT] == 0.0:
+            continue  # a segment of a leg as drawn: no foot at its end
         # The other foot itself: every cell whose centre is within feet_block_radius.
         fx = other_legs[j, 2]
         fz = other_legs[j, 3]
@@ -226,7 +229,9 @@ def _minmod(forward, backward):
 def footprint_features(p, x, z, elev_dil, elev_raw, prox_dt, wp, pref_x, pref_z, hip_x, hip_z, other_legs, cell,
                        features):
     """Fill ``features[:5]`` (FEAT_* order) with the raw footprint features of cell p; False if
-    the leg hip -> (x, z) crosses another leg (the cell is refused outright, no features)."""
+    the leg hip -> (x, z) crosses another leg or a segment of one as drawn (``other_legs``,
+    ``planner.layout.LEG_ROW``; the cell is refused outright, no features). The leg gap is the
+    least distance from (x, z) to every row, and from every other foot to the leg hip -> (x, z)."""
     features[FEAT_DISTANCE] = math.hypot(x - pref_x, z - pref_z)
     e = elev_dil[p]
     rough = 0.0
@@ -244,7 +249,9 @@ def footprint_features(p, x, z, elev_dil, elev_raw, prox_dt, wp, pref_x, pref_z,
         fz = other_legs[j, 3]
         if segments_cross(hip_x, hip_z, x, z, hx, hz, fx, fz):
             return False
-        gap = min(gap, segment_point_distance(x, z, hx, hz, fx, fz), segment_point_distance(fx, fz, hip_x, hip_z, x, z))
+        gap = min(gap, segment_point_distance(x, z, hx, hz, fx, fz))
+        if other_legs[j, LEG_FOOT] != 0.0:
+            gap = min(gap, segment_point_distance(fx, fz, hip_x, hip_z, x, z))
     features[FEAT_LEG_GAP] = gap
     features[FEAT_PROXIMITY] = prox_dt[p]
     return True
@@ -292,7 +299,7 @@ def _clear_of_other_feet(x, z, other_legs, leg_gap, feet_block_radius):
 def _near_other_foot(x, z, other_legs, feet_block_radius):
     """A footprint at (x, z) within ``feet_block_radius`` of another foot (of the character or not)."""
     for j in range(other_legs.shape[0]):
-        if math.hypot(x - other_legs[j, 2], z - other_legs[j, 3]) <= feet_block_radius:
+        if other_legs[j, LEG_FOOT] != 0.0 and math.hypot(x - other_legs[j, 2], z - other_legs[j, 3]) <= feet_block_radius:
             return True
     return False
 
@@ -325,6 +332,8 @@ def out_of_other_feet(x, z, cx, cz, cell, other_legs, feet_block_radius, whole_l
     best = feet_block_radius
     qx = qz = 0.0
     for j in range(other_legs.shape[0]):  # the nearest, the first of equals
+        if not whole_legs and other_legs[j, LEG_FOOT] == 0.0:
+            continue
         ax, az = _nearest_on_leg(x, z, other_legs[j], whole_legs)
         d = math.hypot(x - ax, z - az)
         if d <= feet_block_radius and (nearest < 0 or d < best):
@@ -341,6 +350,8 @@ def out_of_other_feet(x, z, cx, cz, cell, other_legs, feet_block_radius, whole_l
     if abs(nx - cx) > h or abs(nz - cz) > h:
         return False, x, z
     for j in range(other_legs.shape[0]):
+        if not whole_legs and other_legs[j, LEG_FOOT] == 0.0:
+            continue
         ax, az = _nearest_on_leg(nx, nz, other_legs[j], whole_legs)
         if math.hypot(nx - ax, nz - az) <= feet_block_radius:
             return False, x, z
@@ -562,8 +573,8 @@ def slice_maps(code, boxh_dil, level, eps, source_p, in_reach, hp, wp, cell, pot
 
 @nb.njit(cache=True)
 def path_crosses_legs(points, n, col_z, other_legs):
-    """The polyline ``points[:n]`` (x in column 0, z in ``col_z``) crosses the ground projection
-    (hip -> foot) of one of ``other_legs``. A boxed-in foot's way out passes cells of other legs'
+    """The polyline ``points[:n]`` (x in column 0, z in ``col_z``) crosses a row of ``other_legs``
+    (``planner.layout.LEG_ROW``: a leg's ground projection hip -> foot, or a segment of one as drawn). A boxed-in foot's way out passes cells of other legs'
     projections (:func:`slice_maps`), so its paths are checked on the segments themselves."""
     for i in range(n - 1):
         for j in range(other_legs.shape[0]):

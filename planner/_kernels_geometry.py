@@ -204,6 +204,78 @@ def segments_cross(ax, az, bx, bz, cx, cz, dx, dz):
 
 
 @nb.njit(cache=True)
+def _bow(drawn, c, leg):
+    """The largest distance of a point of polyline ``drawn[c, leg]`` (x in column 0, z in column 2)
+    from the segment between its first and last points, m."""
+    p = drawn.shape[2]
+    ax = drawn[c, leg, 0, 0]
+    az = drawn[c, leg, 0, 2]
+    bx = drawn[c, leg, p - 1, 0]
+    bz = drawn[c, leg, p - 1, 2]
+    largest = 0.0
+    for k in range(1, p - 1):
+        largest = max(largest, segment_point_distance(drawn[c, leg, k, 0], drawn[c, leg, k, 2], ax, az, bx, bz))
+    return largest
+
+
+@nb.njit(cache=True)
+def bowed_legs_onto_lines(drawn, chars, legs, straight, tolerance, n_columns):
+    """(rows (R, ``n_columns``), start (F + 1,)): for each request i, the legs ``legs[i]`` of character
+    ``chars[i]`` as drawn (``drawn`` (C, L, P, 3) polylines, hip first, foot last) whose inner points
+    leave the segment between their ends by more than ``tolerance`` (m), moved onto the line
+    ``straight[i, k]`` (hip x, z, foot x, z): each point by the move of the hip and the move of the
+    foot, blended by its share of the polyline's length from the hip (the ends land on the line's
+    ends; the shape between them is carried, not scaled). P - 1 segment rows (x0, z0, x1, z1, then
+    zeros) per such leg, request by request."""
+    f, k = legs.shape
+    p = drawn.shape[2]
+    keep = np.zeros((f, k), dtype=np.bool_)
+    start = np.zeros(f + 1, dtype=np.int64)
+    for i in range(f):
+        n = 0
+        for j in range(k):
+            if _bow(drawn, chars[i], legs[i, j]) > tolerance:
+                keep[i, j] = True
+                n += p - 1
+        start[i + 1] = start[i] + n
+    rows = np.zeros((start[f], n_columns))
+    share = np.empty(p)
+    xs = np.empty(p)
+    zs = np.empty(p)
+    for i in range(f):
+        r = start[i]
+        c = chars[i]
+        for j in range(k):
+            if not keep[i, j]:
+                continue
+            leg = legs[i, j]
+            share[0] = 0.0
+            for q in range(1, p):
+                share[q] = share[q - 1] + math.hypot(drawn[c, leg, q, 0] - drawn[c, leg, q - 1, 0],
+                                                     drawn[c, leg, q, 2] - drawn[c, leg, q - 1, 2])
+            total = share[p - 1]
+            hx = straight[i, j, 0] - drawn[c, leg, 0, 0]
+            hz = straight[i, j, 1] - drawn[c, leg, 0, 2]
+            fx = straight[i, j, 2] - drawn[c, leg, p - 1, 0]
+            fz = straight[i, j, 3] - drawn[c, leg, p - 1, 2]
+            for q in range(p):
+                u = share[q] / total if total > 0.0 else 0.0
+                xs[q] = drawn[c, leg, q, 0] + (1.0 - u) * hx + u * fx
+                zs[q] = drawn[c, leg, q, 2] + (1.0 - u) * hz + u * fz
+            xs[p - 1] = straight[i, j, 2]  # the ends exactly (no rounding off the line's ends)
+            zs[p - 1] = straight[i, j, 3]
+            xs[0] = straight[i, j, 0]
+            zs[0] = straight[i, j, 1]
+            for q in range(p - 1):
+                rows[r, 0] = xs[q]
+                rows[r, 1] = zs[q]
+                rows[r, 2] = xs[q + 1]
+                rows[r, 3] = zs[q + 1]
+                r += 1
+    return rows, start
+
+
+@nb.njit(cache=True)
 def segments_cross_rows(p0, p1, q0, q1, out):
     """``out[k]``: :func:`segments_cross` of rows k of segments p0 -> p1 and q0 -> q1 ((N, 2) x, z each)."""
     for k in range(out.shape[0]):

@@ -12,7 +12,8 @@ from footfall.planner._kernels_wavefront import wavefront
 from footfall.planner._maps import LocalMaps
 from footfall.planner._params import DEFAULT_BUDGET, PlannerConfig, SearchBudget
 from footfall.planner._weights import SCORE_TERMS, ScoringWeights
-from footfall.planner.layout import COUNTERS, N_COUNTERS, N_RAW, RAW_METRICS, SCORE_COUPLE, SCORE_FOOTPRINT, SCORE_TRAJECTORY
+from footfall.planner.layout import (COUNTERS, LEG_FOOT, N_COUNTERS, N_LEG_COLUMNS, N_RAW, RAW_METRICS, SCORE_COUPLE,
+                                     SCORE_FOOTPRINT, SCORE_TRAJECTORY)
 
 MODES = {"search": MODE_SEARCH, "per_target": MODE_PER_TARGET, "brute_force": MODE_BRUTE_FORCE}
 
@@ -49,6 +50,10 @@ class FootQuery:
         (radians, world yaw convention: direction (cos, sin) in (x, z)).
     other_legs : ndarray, shape (M, 4)
         Rows (hip_x, hip_z, foot_x, foot_z) of the other legs; none by default.
+    drawn_segments : ndarray, shape (K, 4)
+        Rows (x0, z0, x1, z1): segments of other legs' ground projections as drawn (hip, knees,
+        foot), where they leave the straight hip -> foot line; the footprint and its leg keep off
+        their lines as off ``other_legs``, but no foot ends them. None by default.
 
     Examples
     --------
@@ -75,6 +80,7 @@ class FootQuery:
     foot_width: float
     foot_yaw: float
     other_legs: np.ndarray = field(default_factory=lambda: np.zeros((0, 4)))
+    drawn_segments: np.ndarray = field(default_factory=lambda: np.zeros((0, 4)))
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "source", _vec("FootQuery.source", self.source, 3))
@@ -84,6 +90,10 @@ class FootQuery:
         if not np.isfinite(legs).all():
             raise ValueError("FootQuery.other_legs: must be finite")
         object.__setattr__(self, "other_legs", legs)
+        drawn = np.ascontiguousarray(np.asarray(self.drawn_segments, dtype=np.float64).reshape(-1, 4))
+        if not np.isfinite(drawn).all():
+            raise ValueError("FootQuery.drawn_segments: must be finite")
+        object.__setattr__(self, "drawn_segments", drawn)
         for name in ("reach_xz", "foot_length", "foot_width"):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
@@ -94,9 +104,48 @@ class FootQuery:
                 raise ValueError(f"FootQuery.{name}: expected a finite number, got {v!r}")
 
     @property
+    def kernel_legs(self) -> np.ndarray:
+        """(M + K, 5) the rows the kernels read (``planner.layout.LEG_ROW``): ``other_legs``, each
+        ending in a foot, then ``drawn_segments``, none."""
+        return leg_rows(self.other_legs, self.drawn_segments)
+
+    @property
     def feet_block_radius(self) -> float:
         """Other feet block cells within two foot half-diagonals (feet never overlap)."""
         return float(math.hypot(self.foot_length, self.foot_width))
+
+
+def leg_rows(other_legs, drawn_segments=None) -> np.ndarray:
+    """(M + K, 5) kernel rows (``planner.layout.LEG_ROW``) of legs ending in feet, (M, 4), and of
+    segments of legs as drawn, (K, 4).
+
+    >>> leg_rows(np.array([[0.0, 0.0, 1.0, 0.0]]), np.array([[0.0, 0.0, 0.5, 0.1]]))
+    array([[0. , 0. , 1. , 0. , 1. ],
+           [0. , 0. , 0.5, 0.1, 0. ]])
+    """
+    legs = np.asarray(other_legs, dtype=np.float64).reshape(-1, 4)
+    drawn = np.zeros((0, 4)) if drawn_segments is None else np.asarray(drawn_segments, dtype=np.float64).reshape(-1, 4)
+    out = np.zeros((legs.shape[0] + drawn.shape[0], N_LEG_COLUMNS))
+    out[:legs.shape[0], :4] = legs
+    out[:legs.shape[0], LEG_FOOT] = 1.0
+    out[legs.shape[0]:, :4] = drawn
+    return out
+
+
+def split_leg_rows(rows) -> dict:
+    """``{"other_legs": (M, 4), "drawn_segments": (K, 4)}``: the :class:`FootQuery` fields of kernel
+    rows (``planner.layout.LEG_ROW``, those that end in a foot first, as a ``FootBatch`` holds them);
+    the inverse of :func:`leg_rows`.
+
+    >>> parts = split_leg_rows(leg_rows(np.array([[0.0, 0.0, 1.0, 0.0]]), np.array([[0.0, 0.0, 0.5, 0.1]])))
+    >>> parts["other_legs"].tolist(), parts["drawn_segments"].tolist()
+    ([[0.0, 0.0, 1.0, 0.0]], [[0.0, 0.0, 0.5, 0.1]])
+    """
+    rows = np.asarray(rows, dtype=np.float64).reshape(-1, N_LEG_COLUMNS)
+    feet = rows[:, LEG_FOOT] != 0.0
+    if feet.size and not (feet[:-1] >= feet[1:]).all():
+        raise ValueError("rows: the rows that end in a foot must come first")
+    return {"other_legs": rows[feet, :4].copy(), "drawn_segments": rows[~feet, :4].copy()}
 
 
 @dataclass(frozen=True)
@@ -251,7 +300,7 @@ def plan_foot(maps: LocalMaps, query: FootQuery, weights: ScoringWeights | None 
     out = plan_foot_kernel(
         maps.elevation, maps.ground, maps.forbidden, maps.frame.origin_x, maps.frame.origin_z, foot_shape,
         query.source, query.preferred, query.hip, float(query.reach_xz), float(query.step_height),
-        query.other_legs, query.feet_block_radius, weights.to_array(), config.to_array(),
+        query.kernel_legs, query.feet_block_radius, weights.to_array(), config.to_array(),
         couples_after_first, slice_size, early, MODES[mode])
     return CoupleResult(
         valid=bool(out.valid), target_cell=(int(out.target_rc[0]), int(out.target_rc[1])), target=out.target_xyz,

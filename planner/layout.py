@@ -96,6 +96,14 @@ SEARCH_MODES: tuple[str, ...] = ("search", "per_target", "brute_force")
 """How the couple search runs: the paper's search, one wavefront per target, every couple."""
 MODE_SEARCH, MODE_PER_TARGET, MODE_BRUTE_FORCE = range(len(SEARCH_MODES))
 
+LEG_ROW: tuple[str, ...] = ("hip_x", "hip_z", "foot_x", "foot_z", "ends_in_foot")
+"""A row of the legs a foot's landing keeps clear of (``FootBatch.legs``): a segment of another leg's
+ground projection, (x, z) to (x, z), and 1.0 when its end is a foot (a leg hip -> foot, or another
+character's foot as a zero-length leg), 0.0 for a segment of a leg as drawn (hip, knees, foot), which
+only its line keeps feet off (:func:`planner._kernels_foot.footprint_features`)."""
+LEG_HIP_X, LEG_HIP_Z, LEG_FOOT_X, LEG_FOOT_Z, LEG_FOOT = range(len(LEG_ROW))
+N_LEG_COLUMNS = len(LEG_ROW)
+
 REQUEST_KINDS: tuple[str, ...] = ("none", "new_swing", "forced_step", "replan")
 """What the crowd asks of a foot in a frame (``planner._crowd.stage_requests``; the harvest's ``kind``)."""
 KIND_NONE, KIND_NEW_SWING, KIND_FORCED_STEP, KIND_REPLAN = range(len(REQUEST_KINDS))
@@ -110,6 +118,7 @@ __all__ = [
     "CONFIG_FIELDS", "COUNTERS",
     "FEAT_DISTANCE", "FEAT_LEG_GAP", "FEAT_PROXIMITY", "FEAT_ROUGHNESS", "FEAT_SLOPE", "FEATURES",
     "FOOTPRINT_TERMS", "KIND_FORCED_STEP", "KIND_NEW_SWING", "KIND_NONE", "KIND_REPLAN", "MODE_BRUTE_FORCE", "MODE_PER_TARGET", "MODE_SEARCH",
+    "LEG_FOOT", "LEG_FOOT_X", "LEG_FOOT_Z", "LEG_HIP_X", "LEG_HIP_Z", "LEG_ROW", "N_LEG_COLUMNS",
     "N_COUNTERS", "N_FEATURES", "N_FOOTPRINT_TERMS", "N_RAW", "N_TERMS",
     "RAW_CLEARANCE", "RAW_CLIMB", "RAW_CURVATURE", "RAW_JERK", "RAW_LENGTH", "RAW_METRICS",
     "REQUEST_KINDS", "SCORE_COUPLE", "SCORE_FOOTPRINT", "SCORE_TERMS", "SCORE_TRAJECTORY", "SCORES", "SEARCH_MODES",

@@ -627,6 +627,7 @@ def footprint_situation(sample, n_other: int = 14) -> dict:
     the score order (so that cell is the only target).
     """
     from footfall.planner import FootQuery, GridFrame, LocalMaps, SearchBudget, plan_foot
+    from footfall.planner._search import split_leg_rows
 
     batch, out, k, weights, config, _ = sample
     ch = int(batch.foot_char[k])
@@ -637,7 +638,7 @@ def footprint_situation(sample, n_other: int = 14) -> dict:
                       reach_xz=float(batch.reach_xz[k]), step_height=float(batch.step_height[k]),
                       foot_length=float(batch.foot_shape[k, 0]), foot_width=float(batch.foot_shape[k, 1]),
                       foot_yaw=float(batch.foot_shape[k, 2]),
-                      other_legs=batch.legs[batch.legs_start[k]:batch.legs_start[k + 1]])
+                      **split_leg_rows(batch.legs[batch.legs_start[k]:batch.legs_start[k + 1]]))
     couples = int(batch.couples_after_first[k])
     slices = float(batch.slice_size[k])
     budget = SearchBudget(None if couples < 0 else couples, None if slices <= 0 else slices,

@@ -905,6 +905,28 @@ def test_a_body_whose_way_lies_behind_it_comes_round_on_the_spot_at_its_turn_rat
         assert counters.leg_crossings == 0, f"seed {seed}"
 
 
+def test_a_landing_keeps_clear_of_a_neighbours_leg_as_drawn_on_a_stair():
+    # A spider starting on the held-out stairs (rise 0.1 m, run 0.3 m), its body pitched: its legs' planes
+    # tilt with it and a knee is drawn up to 4 cm off the leg's straight hip -> foot line. Planned
+    # against the straight lines only, leg 2 landed 2 cm behind leg 1's foot, clear of its line but
+    # across its drawn knee (seed 502, frames 6-7, found by the preset matrix's held-out runs); the
+    # planner keeps landings off the legs as drawn (planner._crowd.drawn_leg_segments).
+    from footfall.planner._counters import count_polyline_crossings, rendered_joints
+    from footfall.planner._crowd import step
+
+    scenario = load_scenario("stairs@terrain.rise=0.1,terrain.run=0.3,crowd.centre=[-1.3,0.0]")
+    creature = load_creature("spider")
+    gait, _, _ = resolve_gait(scenario, creature)
+    model, state = init_crowd(scenario, creature, gait, n_characters=1, seed=502)
+    out = np.zeros(1, np.int64)
+    crossed = []
+    for frame in range(12):
+        step(model, state)
+        count_polyline_crossings(np.ascontiguousarray(rendered_joints(model, state)), out)
+        crossed += [frame] * int(out[0])
+    assert crossed == []
+
+
 def test_a_pose_that_draws_two_stood_legs_crossed_is_taken_back():
     # A spider standing on its eight feet at heading 0, its left front foot (leg 0) put down 1 cm in
     # front of the next leg's ground line, 40 % of the way from that leg's hip to its foot: no legs

@@ -7,7 +7,8 @@ import pytest
 
 from conftest import fresh_seeds
 
-from footfall.planner._kernels_geometry import foot_offsets, rasterise_boxes, segments_cross, supercover_visit
+from footfall.planner._kernels_geometry import (bowed_legs_onto_lines, foot_offsets, rasterise_boxes, segments_cross,
+                                                supercover_visit)
 
 
 def _cells(ax, az, bx, bz, cell=1.0):
@@ -126,3 +127,22 @@ def test_points_near_equals_brute_force_on_random_crowds(seed):
     for k in range(q):
         expected = np.flatnonzero((d[k] <= radius) & (owner != query_owner[k]))
         assert index[start[k]:start[k + 1]].tolist() == expected.tolist(), f"seed {seed}, query {k}"
+
+
+def test_legs_as_drawn_are_carried_onto_their_lines_where_they_leave_them():
+    # Character 0, legs 1-3 (P = 3 points: hip, knee, foot) asked for by one planned foot.
+    drawn = np.zeros((1, 4, 3, 3))
+    drawn[0, 1, :, 0] = [0.0, 0.05, 0.1]           # along its line: no rows
+    drawn[0, 2, :, 0] = [0.0, -0.05, 0.02]         # a quadruped's knee 5 cm before its hip, on the line
+    drawn[0, 3, :, 0] = [0.0, 0.05, 0.1]
+    drawn[0, 3, 1, 2] = 0.0015                     # a knee 1.5 mm off its line: under the tolerance
+    straight = np.array([[[0.0, 0.0, 0.1, 0.0], [0.0, 1.0, 0.02, 1.0], [0.0, 0.0, 0.1, 0.0]]])
+    rows, start = bowed_legs_onto_lines(drawn, np.array([0]), np.array([[1, 2, 3]]), straight, 0.002, 5)
+    # Leg 2: hip and foot both move by (0, 1): the knee with them, to (-0.05, 1); two segment rows.
+    np.testing.assert_allclose(rows, [[0.0, 1.0, -0.05, 1.0, 0.0], [-0.05, 1.0, 0.02, 1.0, 0.0]], rtol=0, atol=1e-15)
+    assert start.tolist() == [0, 2]
+    # The hip moves by (0, 1), the foot by (0.03, 0): the knee, 0.05 of the leg's 0.12 m from the hip,
+    # moves by 7/12 (0, 1) + 5/12 (0.03, 0).
+    straight[0, 1] = [0.0, 1.0, 0.05, 0.0]
+    rows, _ = bowed_legs_onto_lines(drawn, np.array([0]), np.array([[1, 2, 3]]), straight, 0.002, 5)
+    np.testing.assert_allclose(rows[0, 2:4], [-0.05 + 5 / 12 * 0.03, 7 / 12], rtol=0, atol=1e-15)

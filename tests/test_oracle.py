@@ -58,6 +58,7 @@ from scipy.sparse.csgraph import dijkstra
 
 from conftest import fresh_seeds
 from footfall.planner import EXHAUSTIVE, FootQuery, GridFrame, LocalMaps, PlannerConfig, ScoringWeights, harvest_foot, plan_foot
+from footfall.planner.layout import FEAT_LEG_GAP
 
 SCORE_TOL = 1e-9  # a score or goodness, dimensionless
 METRIC_TOL = 1e-9  # a raw metric (m, rad, or the scale-free energies, relative)
@@ -130,11 +131,14 @@ def nearest_on_segment(px, pz, ax, az, bx, bz):
 
 def pushed_out(x, z, cx, cz, half, legs, radius, whole_legs):
     """A footprint within ``radius`` of another foot (``whole_legs``: of another leg's hip -> foot
-    segment) moved straight away from the nearest one to ``radius`` + PUSH_BEYOND_M; None when that
-    leaves the cell's closed square or comes within ``radius`` of another. (The documented rule of
-    ``out_of_other_feet``.)"""
+    segment, or a segment of a leg as drawn) moved straight away from the nearest one to ``radius`` +
+    PUSH_BEYOND_M; None when that leaves the cell's closed square or comes within ``radius`` of
+    another. (The documented rule of ``out_of_other_feet``.) ``legs``: (a, b, fx, fz, ends in a foot)."""
+    if not whole_legs:
+        legs = [leg for leg in legs if leg[4]]  # a drawn segment's end is no foot
+
     def nearest(px, pz, leg):
-        a, b, fx, fz = leg
+        a, b, fx, fz, _ = leg
         return nearest_on_segment(px, pz, a, b, fx, fz) if whole_legs else (fx, fz)
 
     near = [(math.hypot(x - qx, z - qz), qx, qz) for qx, qz in (nearest(x, z, leg) for leg in legs)]
@@ -300,13 +304,14 @@ class Oracle:
                 code[r, c] = FORBIDDEN if self.forb[r, c] else (SIZE_INCREASE if touches else FREE)
         # The other legs (hip -> foot) and the other feet block cells (§4: no leg crossing; §5.1).
         radius = q.feet_block_radius
-        for hx, hz, fx, fz in q.other_legs:
+        for hx, hz, fx, fz, foot in q.kernel_legs:
             cells = cells_touched(hx, hz, fx, fz, self.ox, self.oz, cell, n_rows, n_cols)
-            for r in range(n_rows):
-                for c in range(n_cols):
-                    x, z = cell_centre(r, c, self.ox, self.oz, cell)
-                    if math.hypot(x - fx, z - fz) <= radius:
-                        cells.append((r, c))
+            if foot:  # (a segment of a leg as drawn blocks only the cells it passes: no foot ends it)
+                for r in range(n_rows):
+                    for c in range(n_cols):
+                        x, z = cell_centre(r, c, self.ox, self.oz, cell)
+                        if math.hypot(x - fx, z - fz) <= radius:
+                            cells.append((r, c))
             for r, c in cells:
                 if code[r, c] == FREE or (leg_over_size_increase and code[r, c] == SIZE_INCREASE):
                     code[r, c] = OTHER_LEG
@@ -320,7 +325,8 @@ class Oracle:
         h = 0.5 * cell
         px, pz = self.pref_x, self.pref_z
         hip_x, hip_z = (float(v) for v in q.hip)
-        legs = [tuple(map(float, leg)) for leg in q.other_legs]
+        legs = [(*map(float, leg[:4]), bool(leg[4])) for leg in q.kernel_legs]
+        feet = [(fx, fz) for _, _, fx, fz, foot in legs if foot]
         radius = q.feet_block_radius
         weights = np.array([w.footprint_distance, w.footprint_elevation, w.footprint_slope, w.footprint_leg_spacing,
                             w.footprint_obstacle_proximity])
@@ -344,18 +350,18 @@ class Oracle:
                     continue
                 if math.hypot(tx - hip_x, tz - hip_z) > q.reach_xz:
                     continue
-                if any(proper_crossing((hip_x, hip_z), (tx, tz), (a, b), (fx, fz)) for a, b, fx, fz in legs):
-                    continue  # the leg would cross another: refused outright
-                gap = min([min(point_segment_distance(tx, tz, a, b, fx, fz),
-                               point_segment_distance(fx, fz, hip_x, hip_z, tx, tz)) for a, b, fx, fz in legs],
+                if any(proper_crossing((hip_x, hip_z), (tx, tz), (a, b), (fx, fz)) for a, b, fx, fz, _ in legs):
+                    continue  # the leg would cross another (or a drawn segment of one): refused outright
+                gap = min([point_segment_distance(tx, tz, a, b, fx, fz) for a, b, fx, fz, _ in legs]
+                          + [point_segment_distance(fx, fz, hip_x, hip_z, tx, tz) for fx, fz in feet],
                           default=math.inf)
                 if gap < 0.5 * radius:
                     continue  # half a foot's room from every other leg, both ways (LEG_CLEARANCE)
                 if other_leg_cell:
                     # ... and with a foot's room from every leg and foot, both ways.
-                    if gap < radius or any(math.hypot(tx - fx, tz - fz) <= radius for _, _, fx, fz in legs):
+                    if gap < radius or any(math.hypot(tx - fx, tz - fz) <= radius for fx, fz in feet):
                         continue
-                if any(math.hypot(tx - fx, tz - fz) <= radius for _, _, fx, fz in legs):
+                if any(math.hypot(tx - fx, tz - fz) <= radius for fx, fz in feet):
                     continue  # within a foot's room of another foot (whatever its cell)
                 assert 0 < r < self.n_rows - 1 and 0 < c < self.n_cols - 1, "a footprint on the map's edge"
                 e = self.elev_dil[r, c]
@@ -782,6 +788,21 @@ def random_case(rng):
                  "footprint_obstacle_proximity", "trajectory_length", "trajectory_curvature", "trajectory_clearance",
                  "trajectory_climb", "trajectory_jerk")
         weights = ScoringWeights(**{n: float(v) for n, v in zip(names, rng.uniform(0.1, 3.0, size=10))})
+    # Some legs are also drawn with a knee bowed off their straight line (a tilted body's legs:
+    # planner._crowd.drawn_leg_segments), as two segments that end in no foot. (Drawn last: the
+    # rest of the case is what it was before drawn segments existed.)
+    drawn = []
+    for hx, hz, fx, fz in legs:
+        if rng.random() < 0.5:
+            continue
+        # bowed toward the preferred footprint mostly, where it can refuse a footprint
+        ln = max(math.hypot(fx - hx, fz - hz), 1e-9)
+        toward = math.copysign(1.0, (fx - hx) * (pz - hz) - (fz - hz) * (px - hx))
+        t, bow = rng.uniform(0.3, 0.9), toward * rng.uniform(-0.02, 0.08)
+        kx, kz = hx + t * (fx - hx) - bow * (fz - hz) / ln, hz + t * (fz - hz) + bow * (fx - hx) / ln
+        if ((r, c) not in cells_touched(hx, hz, kx, kz, ox, oz, CELL, N, N) + cells_touched(kx, kz, fx, fz, ox, oz, CELL, N, N)):
+            drawn += [(hx, hz, kx, kz), (kx, kz, fx, fz)]
+    query = dataclasses.replace(query, drawn_segments=np.array(drawn).reshape(-1, 4))
     return LocalMaps(frame, elevation, ground, forbidden), query, weights
 
 
@@ -1090,6 +1111,29 @@ def test_hand_footprint_terms():
                                rtol=0, atol=HAND_TOL)
     # (3 * 0.9 + 0.75 + 1 + 0.78790862414 + 0.4) / 7
     assert h.cand_scores[k] == pytest.approx(0.8054155177348126, abs=HAND_TOL)
+
+
+def test_hand_a_leg_drawn_with_a_bowed_knee_is_kept_clear_of_as_drawn():
+    # The scene of test_hand_footprint_terms without boxes: foot at (0.15, 0.25), hip (0.05, 0.25),
+    # P = (0.27, 0.33) in cell (3, 2). Another leg, hip (0.45, 0.05) -> foot (0.45, 0.45), straight down
+    # column 4; drawn, its knee bows to K = (0.32, 0.25): segments (0.45, 0.05) -> K -> (0.45, 0.45)
+    # (a tilted body's leg: planner._crowd.drawn_leg_segments).
+    flat = np.zeros((5, 5))
+    straight = FootQuery(source=(0.15, 0.0, 0.25), preferred=(0.27, 0.33), hip=(0.05, 0.25), reach_xz=0.7,
+                         step_height=0.05, other_legs=np.array([[0.45, 0.05, 0.45, 0.45]]), **FOOT)
+    drawn = dataclasses.replace(straight, drawn_segments=np.array([[0.45, 0.05, 0.32, 0.25], [0.32, 0.25, 0.45, 0.45]]))
+    h0, h1 = (harvest_foot(_hand_maps(flat, flat), q, budget=EXHAUSTIVE, config=HAND_CONFIG) for q in (straight, drawn))
+    # leg gap at P, straight: P to the leg x = 0.45 is 0.18; the other foot to hip -> P is |(0.18, 0.12)|.
+    assert h0.cand_features[_row(h0, (3, 2)), FEAT_LEG_GAP] == pytest.approx(0.18, abs=HAND_TOL)
+    # drawn: P to K -> (0.45, 0.45), direction (0.13, 0.2): |(-0.05, 0.08) x (0.13, 0.2)| / |(0.13, 0.2)|
+    # = 0.0204 / sqrt(0.0569) (the nearest point is inside the segment: t = 0.0095 / 0.0569)
+    assert h1.cand_features[_row(h1, (3, 2)), FEAT_LEG_GAP] == pytest.approx(0.0204 / math.sqrt(0.0569), abs=HAND_TOL)
+    # Cell (3, 3), x in [0.3, 0.4], z in [0.3, 0.4]: the knee's lower segment passes it (x 0.3525 at
+    # z 0.3); its footprint (0.30, 0.33) is 0.15 from the straight leg. A candidate only straight.
+    cells0 = set(map(tuple, h0.cand_cells.tolist()))
+    cells1 = set(map(tuple, h1.cand_cells.tolist()))
+    assert (3, 3) in cells0 and (3, 3) not in cells1
+    assert cells1 < cells0
 
 
 def test_hand_footprint_slope_is_the_ground_under_the_foot_not_a_step_beside_it():
