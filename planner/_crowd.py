@@ -1654,10 +1654,10 @@ def _same_character_pairs(cs, idx) -> tuple[np.ndarray, np.ndarray]:
 
 
 DRAWN_LEG_TOLERANCE_M = 0.002
-"""A leg as drawn whose ground projection leaves its straight hip -> foot line by more than this is
+"""m: a leg whose drawn knees leave the segment between its drawn hip and foot by more than this is
 kept clear of as drawn too (:func:`drawn_leg_segments`). A body pitched on a stair tilts its legs'
-planes: a spider's knee was drawn 4 cm off that line, a landing clear of the line landed across the
-knee (``stairs@terrain.rise=0.1,terrain.run=0.3``, seed 502, frames 6-7, legs 1 and 2)."""
+planes: a spider's knee was drawn 4 cm off its hip-to-foot line, and a landing clear of the line landed
+across the knee (``stairs@terrain.rise=0.1,terrain.run=0.3``, seed 502, frames 6-7, legs 1 and 2)."""
 
 
 def drawn_leg_segments(drawn, chars, legs, straight):
