@@ -427,7 +427,6 @@ class CrowdState:
     lod_level: np.ndarray | None = None  # (C,) int8: each character's level of detail (planner._lod, LEVEL_*)
     near_moving_box: np.ndarray | None = None  # (C,) bool: a moving box is near: it plans as a near character
     aim_node: np.ndarray | None = None  # (C,) int: the corner of the way round static boxes aimed at (-1: none)
-    drawn_legs: np.ndarray | None = None  # (C, L, P, 3) the legs as drawn when this frame's requests were made
 
 
 def hips_world(model: CrowdModel, state: CrowdState) -> np.ndarray:
@@ -1811,8 +1810,9 @@ turn (stage_requests). With no floor (half of whatever the steering asks), the b
 went 4 -> 10 (seeds 3000-3009)."""
 
 
-def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, frequency) -> np.ndarray:
-    """(C, L) int8 request kinds: 0 none, 1 new swing, 2 forced step, 3 re-plan."""
+def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, frequency, drawn=None) -> np.ndarray:
+    """(C, L) int8 request kinds: 0 none, 1 new swing, 2 forced step, 3 re-plan. ``drawn``: the legs as
+    drawn at ``hips`` (:func:`rendered_joints`; computed here unless the caller has them)."""
     ctl = model.controller
     state.wants_swing |= (enter | state.sector_missed) & state.in_stance
     state.sector_missed &= ~state.in_stance
@@ -1866,9 +1866,9 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, fre
     far |= turn_crossed_legs(model, state, state.turn_wanted)
     # A stance foot the body turned across another leg steps (its own side again).
     crossing = np.empty(state.in_stance.shape, dtype=np.bool_)
-    # The legs as drawn at this frame's hips: the planning stage keeps landings off them (stage_plan).
-    state.drawn_legs = np.ascontiguousarray(rendered_joints(model, state, hips))
-    stance_legs_crossing(state.drawn_legs, state.in_stance, crossing)
+    if drawn is None:
+        drawn = rendered_joints(model, state, hips)
+    stance_legs_crossing(np.ascontiguousarray(drawn), state.in_stance, crossing)
     far |= crossing
     centres, sizes, yaws, forbidden, moving = boxes
     threatened = np.zeros(state.in_stance.shape, dtype=np.bool_)
@@ -3238,7 +3238,10 @@ def step(model: CrowdModel, state: CrowdState) -> StepRecord:
     stage_swing(model, state, boxes)
     t3 = clock()
     hips = hips_world(model, state)
-    kinds = stage_requests(model, state, enter, boxes, hips, frequency)
+    # The legs as drawn at this frame's hips: the requests step a stance leg drawn across another, and
+    # the plans keep landings off them (stage_requests, stage_plan).
+    drawn = np.ascontiguousarray(rendered_joints(model, state, hips))
+    kinds = stage_requests(model, state, enter, boxes, hips, frequency, drawn)
     budgets = character_budgets(model, state, boxes)
     t4 = clock()
     chars = np.unique(np.nonzero(kinds)[0])
@@ -3248,7 +3251,7 @@ def step(model: CrowdModel, state: CrowdState) -> StepRecord:
         maps = [stage_maps(model, state, group, planning, model.far_first if far else None) for group, far in groups]
         t5 = clock()
         batch, out, cs, ls, calls = stage_plan(model, state, kinds, frequency, budgets, maps, groups, hips, boxes,
-                                               planning, state.drawn_legs)
+                                               planning, drawn)
         plans = FramePlans(cs, ls, kinds[cs, ls], out, batch, tuple(calls))
     else:
         t5 = clock()
