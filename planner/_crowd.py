@@ -129,7 +129,8 @@ class ControllerConfig:
     bob_factor : float
         Pelvis bobbing amplitude, x standing height.
     pelvis_lag : float
-        s, time constant of the body following its support hull; 0: none (the paper's pose).
+        s, time constant of the body following its support hull (default 0.1); 0: none (the paper's
+        pose).
     lookahead_frames, lookahead_every : int
         Stance feet the IK cannot follow this many frames ahead step now; frames between two
         look-ahead checks of a character.
@@ -179,12 +180,11 @@ class ControllerConfig:
     threat_horizon: float = 0.5  # s, ... or this close to it where the box will be this much later
     bob_factor: float = 0.03  # x standing height, pelvis bobbing amplitude
     # s, time constant of the body following its support hull (planner._kernels_body); 0: none, the
-    # paper's pose. Off by default: 0.1 s takes the frames where the body jumps (pitch or roll > 0.1 rad,
-    # or height > 0.1 standing heights, in one frame) from 836 to 124 over every built-in scenario x
-    # creature but flat (6 characters, 300 frames, seed 2005), but on `footfall evaluate --seeds 6
-    # --seed-base 1000 --characters 8 --frames 600 --lod off` it moves feet in boxes 635 -> 729 and shared
-    # foot spots 0 -> 6 (crossings 116 -> 98, stuck 760 -> 730 s).
-    pelvis_lag: float = 0.0
+    # paper's pose, which jumps with the hull (a foot lifting off takes its stance point out). 0.1 s
+    # takes the frames whose pitch or roll moves > 0.1 rad in one frame from 901 to 1 over stairs,
+    # crates and hills x the four creatures (6 characters, 300 frames, seeds 1-2), with the crowd
+    # promises (collisions, shared spots, overlaps, feet in boxes) held at 0 either way (README, pelvis).
+    pelvis_lag: float = 0.1
     lookahead_frames: int = 4  # stance feet the IK cannot follow this many frames ahead step now
     lookahead_every: int = 2  # frames between two look-ahead checks of a character (< lookahead_frames)
     ik_slip_margin: float = 3e-4  # m, IK residual that counts as 'cannot follow'

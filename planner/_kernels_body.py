@@ -24,8 +24,8 @@ pelvis below what the feet on the ground can fold to). The body never sinks into
 ground for it: the pelvis stays ``body_thickness`` above the highest ground under the
 body box.
 
-Smoothing (optional, ``ControllerConfig.pelvis_lag``; off by default, see there for what it
-costs): the hull moves in steps (a foot lifting off takes its stance point out, a landing point
+Smoothing (``ControllerConfig.pelvis_lag``, 0.1 s by default; 0 turns it off, see there for
+what it buys): the hull moves in steps (a foot lifting off takes its stance point out, a landing point
 changes when a swing re-plans), and a body set on it each frame jumps with it (up to 0.6 rad of
 pitch and half a standing height in one frame, an ant on ``stairs``). With a lag, the body's
 pitch, roll and base height (the pelvis's before the bob) go ``smoothing`` = 1 - exp(-dt / tau)
