@@ -1,5 +1,6 @@
-"""The pelvis on its support hulls (paper §3.2, Fig. 4b) and the optional lag that follows them
-(``ControllerConfig.pelvis_lag``), on a scene small enough to work out by hand.
+"""The pelvis on its support hulls (paper §3.2, Fig. 4b) and the lag that follows them
+(``ControllerConfig.pelvis_lag``, on by default), on a scene small enough to work out by hand, and on
+seeded runs.
 
 The scene: flat ground at 0, a body 0.2 m long and 0.2 m wide at the origin heading +x (its
 left is +z), standing height 0.3 m, body thickness 0.01 m. Four stance feet at x = +-0.5: the
