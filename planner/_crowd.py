@@ -2439,7 +2439,7 @@ def _take_requests(request: FootBatch, rows: np.ndarray) -> FootBatch:
     counts = starts[rows + 1] - starts[rows]
     legs_start = np.zeros(rows.size + 1, np.int64)
     np.cumsum(counts, out=legs_start[1:])
-    leg_rows = np.repeat(starts[rows] - legs_start[:-1], counts) + np.arange(legs_start[-1])
+    leg_rows = _csr_rows(starts[rows], counts)
     per_foot = {name: np.ascontiguousarray(getattr(request, name)[rows])
                 for name in ("foot_shape", "sources", "preferred", "hips", "reach_xz", "step_height", "block_radius",
                              "couples_after_first", "slice_size", "early")}

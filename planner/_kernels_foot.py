@@ -299,7 +299,9 @@ def _clear_of_other_feet(x, z, other_legs, leg_gap, feet_block_radius):
 def _near_other_foot(x, z, other_legs, feet_block_radius):
     """A footprint at (x, z) within ``feet_block_radius`` of another foot (of the character or not)."""
     for j in range(other_legs.shape[0]):
-        if other_legs[j, LEG_FOOT] != 0.0 and math.hypot(x - other_legs[j, 2], z - other_legs[j, 3]) <= feet_block_radius:
+        if other_legs[j, LEG_FOOT] == 0.0:
+            continue  # a segment of a leg as drawn: no foot at its end
+        if math.hypot(x - other_legs[j, 2], z - other_legs[j, 3]) <= feet_block_radius:
             return True
     return False
 
@@ -574,8 +576,9 @@ def slice_maps(code, boxh_dil, level, eps, source_p, in_reach, hp, wp, cell, pot
 @nb.njit(cache=True)
 def path_crosses_legs(points, n, col_z, other_legs):
     """The polyline ``points[:n]`` (x in column 0, z in ``col_z``) crosses a row of ``other_legs``
-    (``planner.layout.LEG_ROW``: a leg's ground projection hip -> foot, or a segment of one as drawn). A boxed-in foot's way out passes cells of other legs'
-    projections (:func:`slice_maps`), so its paths are checked on the segments themselves."""
+    (``planner.layout.LEG_ROW``: a leg's ground projection hip -> foot, or a segment of one as
+    drawn). A boxed-in foot's way out passes cells of other legs' projections (:func:`slice_maps`),
+    so its paths are checked on the segments themselves."""
     for i in range(n - 1):
         for j in range(other_legs.shape[0]):
             if segments_cross(points[i, 0], points[i, col_z], points[i + 1, 0], points[i + 1, col_z], other_legs[j, 0],
