@@ -267,7 +267,7 @@ def simulate_cmd(
                                          "one by name (spider, ant, ...)"),
     record: Optional[str] = typer.Option(None, help="Save the recording (.npz)"),
     navigate: bool = typer.Option(True, "--navigate/--no-navigate", help="Steer round static boxes and the loops "
-                                  "of moving ones (README: the way round static boxes); --no-navigate: ORCA and "
+                                  "of moving ones (docs/crowds.md: the way round static boxes); --no-navigate: ORCA and "
                                   "the box push alone, as before 2026-11-26"),
     json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),
 ) -> None:
@@ -333,6 +333,8 @@ def evaluate_cmd(
     strict: bool = typer.Option(False, "--strict", help="Exit 1 when any promise is violated"),
     navigate: bool = typer.Option(True, "--navigate/--no-navigate", help="Every run steers round static boxes and "
                                   "the loops of moving ones (as simulate; --no-navigate: as simulate --no-navigate)"),
+    preset: Optional[str] = typer.Option(None, "--preset", help="Walk every run with this preset (a shipped name or "
+                                         "a .json file; it must be for every creature evaluated)"),
     json_out: bool = typer.Option(False, "--json", help="Print one JSON object"),
 ) -> None:
     """Check every promise on scenario x creature x seed runs; list the violations.
@@ -361,6 +363,13 @@ violations and the exact command that replays each of the worst runs.
         load_scenario(name)  # bad input fails here, in one line, before any run
     for name in kinds:
         load_creature(name)
+    preset_path = None
+    if preset is not None:
+        from footfall.cli._named_preset import load_named_preset, named_preset_path
+
+        for name in kinds:  # a preset is one creature's: checked against each before any run
+            load_named_preset(preset, load_creature(name).name)
+        preset_path = str(named_preset_path(preset).resolve())
     drawn = draw_seeds(seeds, seed_base)
     err = _err()
     err.print(f"seeds: {', '.join(map(str, drawn))}", markup=False)
@@ -370,12 +379,13 @@ violations and the exact command that replays each of the worst runs.
         task = bar.add_task("runs", total=total)
         result = evaluate(names, kinds, drawn, characters=characters, frames=frames, lod=lod, workers=workers,
                           cluster=cluster, progress=lambda _t, done: bar.update(task, completed=done),
-                          navigate=navigate)
+                          navigate=navigate, preset=preset, preset_path=preset_path)
     if out is not None:
         pictures = {}
         for k, run in enumerate(result["failed_runs"][:3]):
             pictures[f"worst-{k}.png"] = picture_png(run_one({**run, "characters": characters, "frames": frames,
-                                                              "lod": lod, "navigate": navigate, "picture": True}))
+                                                              "lod": lod, "navigate": navigate, "preset": preset,
+                                                              "preset_path": preset_path, "picture": True}))
         write_outputs(Path(out), result, pictures)
     public = {k: v for k, v in result.items() if not k.startswith("_")}
     if json_out:

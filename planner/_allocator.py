@@ -9,7 +9,7 @@ fresh pages, each zeroed by the kernel on its first write: about 3,000 page faul
 process (``mallopt``: a high ``M_MMAP_THRESHOLD``, so such arrays come from the heap, and a high
 ``M_TRIM_THRESHOLD``, so the heap keeps what is freed) takes them to 1 a frame: 1000 spiders, LOD
 on, a program that only steps the crowd, 50-56 -> 45-46 ms per frame (the same runs, alternating;
-README, Measured). ``footfall simulate`` gains less (a few %): its per-frame metrics keep part of that
+docs/performance.md). ``footfall simulate`` gains less (a few %): its per-frame metrics keep part of that
 memory in use anyway. Results do not depend on it. The price is memory: the process keeps its largest
 frame's worth of arrays after they are freed.
 

@@ -183,7 +183,7 @@ class ControllerConfig:
     # paper's pose, which jumps with the hull (a foot lifting off takes its stance point out). 0.1 s
     # takes the frames whose pitch or roll moves > 0.1 rad in one frame from 901 to 1 over stairs,
     # crates and hills x the four creatures (6 characters, 300 frames, seeds 1-2), with the crowd
-    # promises (collisions, shared spots, overlaps, feet in boxes) held at 0 either way (README, pelvis).
+    # promises (collisions, shared spots, overlaps, feet in boxes) held at 0 either way (docs/locomotion.md, the body that follows its hull).
     pelvis_lag: float = 0.1
     lookahead_frames: int = 4  # stance feet the IK cannot follow this many frames ahead step now
     lookahead_every: int = 2  # frames between two look-ahead checks of a character (< lookahead_frames)
@@ -628,7 +628,7 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
     applied = uncrossing_turn(model, state, np.clip(state.turn_wanted, lo, hi))
     # No turn into another body, as no step (bodies_apart): standing 7 cm beside another ant, one turned
     # its body into the other's (mixed, 64 ants, seed 3, characters 34 and 19, with the hysteresis on
-    # can_make_way tried in session 52: README, crowds and moving boxes).
+    # can_make_way tried in session 52: docs/crowds.md, crowds and moving boxes).
     applied[~bodies_turn_clear(model, state, applied, neighbours)] = 0.0
     state.heading = _wrap(state.heading + applied)
     # What is left of the turn as far as the stance feet let it go on (they bound it each frame until
@@ -740,7 +740,7 @@ def shove_out_of_moving_boxes(model: CrowdModel, state: CrowdState, boxes, neigh
     A shoved body pushes the bodies it would run into (``neighbours``, CSR lists as :func:`_avoid` gives
     them) by the same move, and they theirs (:func:`_push_bodies`): shoved alone, an ant was pushed 6 cm
     into its neighbour's body over 10 frames (``mixed``, 64 ants, seed 3, character 19, frames 450-460,
-    with the hysteresis on :func:`can_make_way` tried in session 52: README, crowds and moving boxes)."""
+    with the hysteresis on :func:`can_make_way` tried in session 52: docs/crowds.md, crowds and moving boxes)."""
     centres, sizes, yaws, _, moving = boxes
     state.shoved[:] = False
     state.shoved_onto_feet[:] = False
@@ -962,7 +962,7 @@ frames 8 -> 10 (4), overlaps 0; 1000 spiders x 300 frames on ``mixed``, LOD on, 
 in boxes 882 -> 769 (1049), overlapping pair-frames 99 -> 23 (44), crossing frames 322 -> 273 (259);
 the crowds bar set as before (stuck 71 -> 72 s, per-stride bars 96 -> 97 runs). Only for escapers with
 no neighbour near (ORCA's near): 517 -> 484 and 882 -> 897. Single runs move by tens of foot-frames
-either way (the escapes are chaotic: README, crowds and moving boxes)."""
+either way (the escapes are chaotic: docs/crowds.md, crowds and moving boxes)."""
 
 
 FLEE_GAIN_MAX = 1.25
@@ -972,7 +972,7 @@ faster than asked; unhindered, it walked at the asked speed: an ant crossing a 0
 0.3 m/s (its flee speed 0.35) had its tucked foot caught (``mixed``, 16 ants, seed 3, frames 412-414).
 Unheld, a quadruped (1.0 m/s against 0.3 asked) lifted three legs at once and crossed them: the bar
 set's crossing frames 0 -> 18 (seeds 3000-3009); held to 1.5 x, seeds 4000-4009: 1 -> 6. Held to 1.25 x
-(README, crowds and moving boxes): 64 ants and spiders on ``mixed`` (600 frames), fresh seeds 10-15 /
+(docs/crowds.md, crowds and moving boxes): 64 ants and spiders on ``mixed`` (600 frames), fresh seeds 10-15 /
 20-25, feet in boxes 159 / 81 -> 104 / 36. The flee speed itself (ORCA's preferred speed, the look-ahead's
 pace) is not held: held too, a spider asked to walk at 0.15 m/s fled a 0.2 m/s crate at 0.19 m/s and
 stayed before it (tests/test_encounters.py, the head-on crate)."""
@@ -1437,7 +1437,7 @@ def stage_gait(model: CrowdModel, state: CrowdState):
 TURNING_FRACTION = 0.5
 """A body turns on the spot (:func:`stage_gait`: its needle at the tempo of the walk asked of it) while the turn it
 wants is at least this fraction of its turn rate and its speed under this fraction of the speed it heads
-for. Measured 2026-11-28 (README, crowds and moving boxes): the crowds issue's bar sets (seeds 3000-3009 /
+for. Measured 2026-11-28 (docs/crowds.md, crowds and moving boxes): the crowds issue's bar sets (seeds 3000-3009 /
 4000-4009), stuck runs 0 / 8 -> 2 / 2 (4.1 -> 2.0 s in all), per-stride runs 3 / 3 -> 2 / 2, crossing
 runs 0 / 1 -> 0 / 1; crowds of 8 / 16 / 64 on ``mixed`` and ``crates`` (spiders, ants), stuck
 3.1 / 12.8 / 54.4 -> 2.0 / 5.5 / 42.0 s, crossing frames 0 / 0 / 4 -> 0; 1000 spiders on ``mixed`` (seeds
@@ -2303,7 +2303,7 @@ def tuck_points(model: CrowdModel, state: CrowdState, cs, ls, hips, boxes=None) 
     boxes (:func:`push_out_of_boxes`, :data:`TUCK_CLEARANCE`). Why: an ant's folded legs reach no
     nearer point than the first, and its body, turning away from a crate that followed it, swung the
     tuck point of the leg on the crate's side into it (``mixed``, 64 ants, seed 1, character 29, frame
-    419, with the hysteresis of README session 52)."""
+    419, with the hysteresis of session 52, docs/crowds.md)."""
     from footfall.planner._workspace import tuck_drop
 
     hip = hips[cs, ls]

@@ -7,7 +7,7 @@ at a few cm/s: in the crowds issue's bar set (``footfall evaluate --seeds 10 --s
 --characters 6 --frames 300``) every stuck character-second was such a character (quadrupeds on
 ``mixed``: 42 s, spiders on ``crates``: 30 s).
 
-So with ``ControllerConfig.navigate`` (on by default; the README's section on the way round static
+So with ``ControllerConfig.navigate`` (on by default; docs/crowds.md, the section on the way round static
 boxes has what it gains and costs) steering aims at the first corner of the shortest way round the boxes, and at
 the route's point itself whenever nothing is in the way. The boxes are the static ones, safe ones
 included: a character walks round a crate where the way round is free, and over a safe one only when

@@ -96,9 +96,11 @@ def violations(summary: dict, scenario: str) -> dict[str, int]:
 
 
 def replay_command(run: dict) -> str:
+    preset = run.get("preset")
     return (f"footfall simulate {run['scenario']} --creature {run['creature']} --seed {run['seed']} "
             f"--characters {run['characters']} --frames {run['frames']} --lod {run['lod']}"
-            f"{'' if run.get('navigate', True) else ' --no-navigate'} --json")
+            f"{'' if run.get('navigate', True) else ' --no-navigate'}"
+            f"{'' if preset is None else f' --preset {preset}'} --json")
 
 
 def run_one(task: dict) -> dict:
@@ -113,12 +115,17 @@ def run_one(task: dict) -> dict:
     own = task["creature"] == scenario.crowd.creature
     gait, _, _ = resolve_gait(scenario if own else None, creature)
     navigate = bool(task.get("navigate", True))
+    preset = None
+    if task.get("preset_path") is not None:
+        from footfall.planner._presets import load_preset
+
+        preset = load_preset(task["preset_path"], creature.name)
     model, summary, recorder = recorded_run(scenario, creature, gait, frames=task["frames"],
                                             characters=task["characters"], seed=task["seed"], lod=task["lod"],
-                                            navigate=navigate, record=bool(task.get("picture")))
+                                            navigate=navigate, record=bool(task.get("picture")), preset=preset)
     s = summary.to_json()
     out = {**{k: task[k] for k in ("scenario", "creature", "seed", "characters", "frames", "lod")},
-           "navigate": navigate,
+           "navigate": navigate, "preset": task.get("preset"), "preset_path": task.get("preset_path"),
            "summary": s, "violations": violations(s, task["scenario"])}
     if recorder is not None:
         a = recorder.arrays
@@ -140,14 +147,18 @@ def draw_seeds(seeds: int, seed_base: int | None) -> list[int]:
 
 
 def evaluate(scenarios, creatures, seeds: list[int], *, characters: int, frames: int, lod: str,
-             workers: int | None = None, cluster: str | None = None, progress=None, navigate: bool = True) -> dict:
+             workers: int | None = None, cluster: str | None = None, progress=None, navigate: bool = True,
+             preset: str | None = None, preset_path: str | None = None) -> dict:
     """Run every scenario x creature x seed; the ``--json`` result plus the runs. ``navigate``:
-    ``ControllerConfig.navigate`` for every run."""
+    ``ControllerConfig.navigate`` for every run. ``preset_path``: a preset file every run walks with
+    (its weights and timing; the caller has checked it is for every creature), ``preset`` the name it
+    was given by (``--preset``, repeated in the replay commands)."""
     from footfall._distribute import run_tasks
 
     t0 = time.perf_counter()
     tasks = [{"scenario": sc, "creature": cr, "seed": int(seed), "characters": characters, "frames": frames,
-              "lod": lod, "navigate": navigate} for sc in scenarios for cr in creatures for seed in seeds]
+              "lod": lod, "navigate": navigate, "preset": preset, "preset_path": preset_path}
+             for sc in scenarios for cr in creatures for seed in seeds]
     runs = run_tasks(run_one, tasks, workers=workers, cluster=cluster, progress=progress)
     totals = {name: 0 for name in PROMISE_NAMES}
     failed = []

@@ -110,3 +110,39 @@ def test_bad_input_is_one_line_and_exit_2(args, field):
     assert proc.returncode == 2, proc.stderr
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("footfall: error:") and field in lines[0], proc.stderr
+
+
+def test_a_preset_walks_every_run_and_its_replay_says_so(monkeypatch):
+    # The ant-stairs preset on a stairs run: the run is `simulate --preset`'s, not the defaults'.
+    import footfall.reports._evaluate as ev
+    from conftest import footfall_cli
+
+    args = ["stairs", "--creatures", "ant", "--seeds", "1", "--seed-base", "3", "--frames", "60", "--characters", "1",
+            "--workers", "1", "--json"]
+    runs = {}
+    real = ev.run_one
+    monkeypatch.setattr(ev, "run_one", lambda task: runs.setdefault(task["preset"], real(task)))
+    for extra in ([], ["--preset", "ant-stairs"]):
+        done = _invoke(*args, *extra)
+        assert done.exit_code == 0, done.output
+    plain, tuned = runs[None]["summary"], runs["ant-stairs"]["summary"]
+    planned = ("cells_expanded", "couples_evaluated", "stride_rel_error_median")
+    assert [plain[k] for k in planned] != [tuned[k] for k in planned]  # the preset chose other footprints
+    replay = ev.replay_command(runs["ant-stairs"])
+    assert replay.endswith("--lod off --preset ant-stairs --json")
+    proc = footfall_cli(*replay.split()[1:])  # ... and replaying it measures the same run
+    assert proc.returncode == 0, proc.stderr
+    replayed = json.loads(proc.stdout)
+    for key in ("steps", "plans", "holds", *planned, "max_stance_slip_m"):
+        assert replayed[key] == tuned[key], key
+
+
+def test_a_preset_for_another_creature_is_one_line_and_exit_2():
+    from conftest import footfall_cli
+
+    proc = footfall_cli("evaluate", "flat", "--creatures", "ant,spider", "--preset", "ant-stairs", "--seeds", "1")
+    assert proc.returncode == 2, proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("footfall: error:") and "ant-stairs" in lines[0], proc.stderr
+    proc = footfall_cli("evaluate", "flat", "--creatures", "ant", "--preset", "no-such-preset", "--seeds", "1")
+    assert proc.returncode == 2 and "--preset" in proc.stderr, proc.stderr
