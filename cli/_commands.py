@@ -788,7 +788,7 @@ elsewhere; a style preset with its style metric >= 2 SE toward its bound; neithe
     """
     from footfall._atomic import write_text_atomic
     from footfall._distribute import check_workers, task_runner
-    from footfall.tuning._matrix import PRESETS, run_matrix
+    from footfall.tuning._matrix import PRESETS, carry_pruned, run_matrix
 
     check_workers(workers, cluster)
     chosen = tuple(n.strip() for n in names.split(",") if n.strip()) if names else tuple(PRESETS)
@@ -803,11 +803,12 @@ elsewhere; a style preset with its style metric >= 2 SE toward its bound; neithe
     if out is not None:
         from pathlib import Path
 
-        if names and Path(out).exists():
-            # Some presets re-proved: their entries replace those of the stored matrix (same terrains and runs).
+        if Path(out).exists():
             stored = json.loads(Path(out).read_text())
+            matrix = carry_pruned(matrix, stored)  # a pruned preset keeps saying why
             same = all(stored.get(k) == matrix[k] for k in ("terrains", "runs_per_cell", "seed_base", "spawns"))
-            if same:
+            if names and same:
+                # Some presets re-proved: their entries replace those of the stored matrix (same terrains and runs).
                 matrix = {**stored, "presets": {**stored["presets"], **matrix["presets"]}}
         write_text_atomic(out, json.dumps(matrix, indent=1, allow_nan=False) + "\n")
     if prune:

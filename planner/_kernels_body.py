@@ -253,6 +253,12 @@ def pelvis_from_hulls(top, origin_x, origin_z, cell, pelvis, heading, support, f
         y_body = max(y_body, min(swing_low, high))
         ground = max(max(y[0], y[1]), max(y[2], max(yl[0], yl[2])))
         y_body = max(y_body, ground + body_thickness)
+        if smoothing < 1.0:
+            # The lag starts from where the limits put the body: a limit that lifted it for a frame (a
+            # swinging foot over a riser, the ground under it) lets it down through the lag, not at once.
+            # Lagging behind them instead, an ant climbing 7 cm risers rose and fell 1-2.7 cm within
+            # two to four frames as its feet swung over each one.
+            base = y_body - bob[c]
         out_base[c] = base
         out_y[c] = y_body
         out_pitch[c] = pitch

@@ -249,6 +249,28 @@ def run_matrix(presets_dir: str | Path, names=None, runs: int = RUNS, terrains=N
     return _clean(out)
 
 
+def carry_pruned(matrix: dict, stored: dict) -> dict:
+    """``matrix`` with each preset it could not find (its file pruned) saying why it was pruned, from
+    ``stored``, the matrix it replaces: a re-proof after a pruning otherwise kept only "not found".
+
+    >>> stored = {"presets": {"a": {"found": True, "passes": False, "why": ["mixed (own): gain -0.4 SE < 2"]}}}
+    >>> new = {"presets": {"a": {"found": False, "passes": False, "why": ["presets/a.json not found"]}}}
+    >>> carry_pruned(new, stored)["presets"]["a"]["why"]
+    ['presets/a.json not found', 'pruned: mixed (own): gain -0.4 SE < 2']
+    >>> carry_pruned(carry_pruned(new, stored), carry_pruned(new, stored))["presets"]["a"]["pruned"]
+    ['mixed (own): gain -0.4 SE < 2']
+    """
+    presets = {}
+    for name, entry in matrix["presets"].items():
+        old = stored.get("presets", {}).get(name) or {}
+        reasons = old.get("pruned") or (old.get("why") if old.get("found") and not old.get("passes") else None)
+        if not entry["found"] and reasons:
+            first = [w for w in entry["why"] if not w.startswith("pruned: ")]
+            entry = {**entry, "pruned": list(reasons), "why": first + [f"pruned: {'; '.join(reasons)}"]}
+        presets[name] = entry
+    return {**matrix, "presets": presets}
+
+
 def _clean(value):
     if isinstance(value, float) and not math.isfinite(value):
         return None
