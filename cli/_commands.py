@@ -363,13 +363,12 @@ violations and the exact command that replays each of the worst runs.
         load_scenario(name)  # bad input fails here, in one line, before any run
     for name in kinds:
         load_creature(name)
-    preset_path = None
+    walk_with = None
     if preset is not None:
-        from footfall.cli._named_preset import load_named_preset, named_preset_path
+        from footfall.cli._named_preset import load_named_preset
 
         for name in kinds:  # a preset is one creature's: checked against each before any run
-            load_named_preset(preset, load_creature(name).name)
-        preset_path = str(named_preset_path(preset).resolve())
+            walk_with = load_named_preset(preset, load_creature(name).name)
     drawn = draw_seeds(seeds, seed_base)
     err = _err()
     err.print(f"seeds: {', '.join(map(str, drawn))}", markup=False)
@@ -379,13 +378,12 @@ violations and the exact command that replays each of the worst runs.
         task = bar.add_task("runs", total=total)
         result = evaluate(names, kinds, drawn, characters=characters, frames=frames, lod=lod, workers=workers,
                           cluster=cluster, progress=lambda _t, done: bar.update(task, completed=done),
-                          navigate=navigate, preset=preset, preset_path=preset_path)
+                          navigate=navigate, preset=walk_with, preset_name=preset)
     if out is not None:
         pictures = {}
         for k, run in enumerate(result["failed_runs"][:3]):
-            pictures[f"worst-{k}.png"] = picture_png(run_one({**run, "characters": characters, "frames": frames,
-                                                              "lod": lod, "navigate": navigate, "preset": preset,
-                                                              "preset_path": preset_path, "picture": True}))
+            again = next(r for r in result["_runs"] if all(r[k] == run[k] for k in ("scenario", "creature", "seed")))
+            pictures[f"worst-{k}.png"] = picture_png(run_one({**again, "picture": True}))
         write_outputs(Path(out), result, pictures)
     public = {k: v for k, v in result.items() if not k.startswith("_")}
     if json_out:

@@ -17,6 +17,7 @@ import html
 import io
 import math
 import secrets
+import shlex
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -100,7 +101,7 @@ def replay_command(run: dict) -> str:
     return (f"footfall simulate {run['scenario']} --creature {run['creature']} --seed {run['seed']} "
             f"--characters {run['characters']} --frames {run['frames']} --lod {run['lod']}"
             f"{'' if run.get('navigate', True) else ' --no-navigate'}"
-            f"{'' if preset is None else f' --preset {preset}'} --json")
+            f"{'' if preset is None else f' --preset {shlex.quote(preset)}'} --json")
 
 
 def run_one(task: dict) -> dict:
@@ -116,16 +117,17 @@ def run_one(task: dict) -> dict:
     gait, _, _ = resolve_gait(scenario if own else None, creature)
     navigate = bool(task.get("navigate", True))
     preset = None
-    if task.get("preset_path") is not None:
-        from footfall.planner._presets import load_preset
+    if task.get("weights") is not None:  # the preset travels as numbers: a worker need not have its file
+        from footfall.planner import GaitTiming, Preset, ScoringWeights
 
-        preset = load_preset(task["preset_path"], creature.name)
+        timing = None if task.get("timing") is None else GaitTiming.from_array(task["timing"])
+        preset = Preset(creature.name, ScoringWeights.from_array(task["weights"]), timing, None, {})
     model, summary, recorder = recorded_run(scenario, creature, gait, frames=task["frames"],
                                             characters=task["characters"], seed=task["seed"], lod=task["lod"],
                                             navigate=navigate, record=bool(task.get("picture")), preset=preset)
     s = summary.to_json()
     out = {**{k: task[k] for k in ("scenario", "creature", "seed", "characters", "frames", "lod")},
-           "navigate": navigate, "preset": task.get("preset"), "preset_path": task.get("preset_path"),
+           "navigate": navigate, **{k: task.get(k) for k in ("preset", "weights", "timing")},
            "summary": s, "violations": violations(s, task["scenario"])}
     if recorder is not None:
         a = recorder.arrays
@@ -148,16 +150,20 @@ def draw_seeds(seeds: int, seed_base: int | None) -> list[int]:
 
 def evaluate(scenarios, creatures, seeds: list[int], *, characters: int, frames: int, lod: str,
              workers: int | None = None, cluster: str | None = None, progress=None, navigate: bool = True,
-             preset: str | None = None, preset_path: str | None = None) -> dict:
+             preset=None, preset_name: str | None = None) -> dict:
     """Run every scenario x creature x seed; the ``--json`` result plus the runs. ``navigate``:
-    ``ControllerConfig.navigate`` for every run. ``preset_path``: a preset file every run walks with
-    (its weights and timing; the caller has checked it is for every creature), ``preset`` the name it
-    was given by (``--preset``, repeated in the replay commands)."""
+    ``ControllerConfig.navigate`` for every run. ``preset``: a :class:`planner.Preset` every run walks
+    with (its weights and timing; the caller has checked it is for every creature), ``preset_name`` what
+    it was given as (``--preset``, repeated in the replay commands)."""
     from footfall._distribute import run_tasks
 
     t0 = time.perf_counter()
+    numbers = {"preset": None, "weights": None, "timing": None}
+    if preset is not None:
+        numbers = {"preset": preset_name, "weights": [float(x) for x in preset.weights.to_array()],
+                   "timing": None if preset.timing is None else [float(x) for x in preset.timing.to_array()]}
     tasks = [{"scenario": sc, "creature": cr, "seed": int(seed), "characters": characters, "frames": frames,
-              "lod": lod, "navigate": navigate, "preset": preset, "preset_path": preset_path}
+              "lod": lod, "navigate": navigate, **numbers}
              for sc in scenarios for cr in creatures for seed in seeds]
     runs = run_tasks(run_one, tasks, workers=workers, cluster=cluster, progress=progress)
     totals = {name: 0 for name in PROMISE_NAMES}
