@@ -361,14 +361,13 @@ violations and the exact command that replays each of the worst runs.
         raise InputError("argument", "--creatures", f"expected comma-separated names, got {creatures!r}")
     for name in names:
         load_scenario(name)  # bad input fails here, in one line, before any run
-    for name in kinds:
-        load_creature(name)
+    creature_names = [load_creature(name).name for name in kinds]
     walk_with = None
     if preset is not None:
         from footfall.cli._named_preset import load_named_preset
 
-        for name in kinds:  # a preset is one creature's: checked against each before any run
-            walk_with = load_named_preset(preset, load_creature(name).name)
+        for name in creature_names:  # a preset is one creature's: checked against each before any run
+            walk_with = load_named_preset(preset, name)
     drawn = draw_seeds(seeds, seed_base)
     err = _err()
     err.print(f"seeds: {', '.join(map(str, drawn))}", markup=False)
