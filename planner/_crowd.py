@@ -422,7 +422,7 @@ class CrowdState:
     goal_speed: np.ndarray  # (C,) m/s: the speed the last steer stage headed for (0 at the goal; braking before it)
     speed_wanted: np.ndarray  # (C,) m/s: the speed the last steer stage asked after turns, avoidance and limits
     blocks_escape: np.ndarray  # (C, L) bool: a stance foot that stops an escaping character's turn
-    crossed: np.ndarray  # (C, L, L) bool: pairs of stance legs drawn crossed at the end of the last frame
+    crossed: np.ndarray  # (C, L, L) bool: pairs of legs standing at the start of the last frame drawn crossed at its end
     counters: dict = field(default_factory=dict)
     lod_level: np.ndarray | None = None  # (C,) int8: each character's level of detail (planner._lod, LEVEL_*)
     near_moving_box: np.ndarray | None = None  # (C,) bool: a moving box is near: it plans as a near character
@@ -2602,7 +2602,8 @@ def _take_back_unfollowed_poses(model: CrowdModel, state: CrowdState, on_screen:
 
 
 def _take_back_crossing_poses(model: CrowdModel, state: CrowdState, stance_before: np.ndarray) -> None:
-    """Two legs that stand through a frame are never drawn crossed by the body's own motion: a body
+    """Two legs whose feet stood at the start of a frame (standing through it, or lifting in it: a swing
+    starts where its foot stood) are never drawn crossed by the body's own motion: a body
     whose new pose (a turn, a move, a tilt) carries two such legs across each other takes the whole
     frame's pose back (``stage_requests`` then steps the legs the turn it asked would cross:
     :func:`turn_crossed_legs`). The turn check of the steering (:func:`uncrossing_turn`) sees the
@@ -2612,12 +2613,13 @@ def _take_back_crossing_poses(model: CrowdModel, state: CrowdState, stance_befor
     from footfall.planner._counters import rendered_joints
     from footfall.planner._kernels_controller import crossing_pairs
 
-    # Only pairs of stance legs: a pair stands through the next frame only if both stand now.
+    # The legs whose feet stood at the start of the frame: those that stand through it and those that
+    # lift in it (a swing starts at its source, where the foot stood: the body's move alone drew it
+    # across its neighbour, spider on crates@seed=13, seed 506, frame 29).
     n, L = state.in_stance.shape
     pairs = np.empty((n, L, L), np.bool_)
-    crossing_pairs(np.ascontiguousarray(rendered_joints(model, state)), state.in_stance, pairs)
-    stood = state.in_stance & stance_before
-    new = pairs & ~state.crossed & stood[:, :, None] & stood[:, None, :]
+    crossing_pairs(np.ascontiguousarray(rendered_joints(model, state)), stance_before, pairs)
+    new = pairs & ~state.crossed
     moved = np.any(_pose(state) != state.pose_before, axis=1)
     # Legs drawn by the IK only (as _take_back_unfollowed_poses): an off-screen character's legs are
     # not drawn, and taking its pose back would solve the IK the level of detail skips.
@@ -2625,7 +2627,7 @@ def _take_back_crossing_poses(model: CrowdModel, state: CrowdState, stance_befor
     if bad.any():
         _take_back_poses(model, state, bad)
         redo = np.empty((int(bad.sum()), L, L), np.bool_)
-        crossing_pairs(np.ascontiguousarray(rendered_joints(model, state)[bad]), state.in_stance[bad], redo)
+        crossing_pairs(np.ascontiguousarray(rendered_joints(model, state)[bad]), stance_before[bad], redo)
         pairs[bad] = redo
         state.counters["crossing_takebacks"] += int(bad.sum())
     state.crossed = pairs

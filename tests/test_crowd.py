@@ -935,7 +935,8 @@ def test_a_pose_that_draws_two_stood_legs_crossed_is_taken_back():
     # the frame's pose is taken back whole (heading, pelvis), and no pair is drawn crossed. Turned
     # left by 0.05 rad, nothing crosses and the turn is kept; a pair already crossed at the frame's
     # start, or a leg in the air then, is not the pose's doing and takes nothing back; nor is anything
-    # taken back from a character off screen (its legs are not drawn, its IK is skipped).
+    # taken back from a character off screen (its legs are not drawn, its IK is skipped). A leg that
+    # lifts in the frame counts as standing (its swing starts where its foot stood).
     from footfall.planner._counters import count_polyline_crossings, rendered_joints
     from footfall.planner._crowd import _pose, _take_back_crossing_poses, stage_ik
 
@@ -980,6 +981,11 @@ def test_a_pose_that_draws_two_stood_legs_crossed_is_taken_back():
     assert turn_by(-0.4) == 1 and state.heading[0] == 0.0 and state.counters["crossing_takebacks"] == 2
     assert turn_by(-0.4, drawn=False) == 1 and state.heading[0] == -0.4
     assert state.counters["crossing_takebacks"] == 2
+    # Leg 0 lifting in the frame: its swing starts where its foot stood, so the turn alone drew it
+    # across leg 1, and the pose is taken back as for two standing legs (a spider on crates@seed=13).
+    state.in_stance[0, 0] = False
+    assert turn_by(-0.05) == 1 and state.heading[0] == 0.0
+    assert drawn_crossings() == 0 and state.counters["crossing_takebacks"] == 3
 
 
 def test_a_tucked_foot_is_no_support_for_the_pelvis():
