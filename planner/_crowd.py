@@ -1415,11 +1415,19 @@ def stage_gait(model: CrowdModel, state: CrowdState):
     # avoiding a neighbour stood ~2 s coming round (crates-moving, seed 4009; TURNING_FRACTION). The
     # asked walk, not the one its holds taught it to sustain: a robot5 held by a foot its leg could not
     # follow learnt a limit whose tempo (1.64 -> 0.8-1.0 Hz) bounded its turn to ~0.5 rad/s again.
+    # A body all but standing (SPOT_FRACTION) steps at the tempo of its top walk instead: at the asked
+    # walk's 0.98 Hz a quadruped came round at 0.6 rad/s, and each time the avoidance's velocity moved
+    # (a right of way given and lapsing) it turned after it again without walking (crates-moving,
+    # seeds 4000 and 8008: stuck 4.1 and 4.3 s).
     ctl = model.controller
     turning = np.abs(state.turn_wanted) >= TURNING_FRACTION * ctl.turn_rate * model.dt
     turning &= (state.speed < TURNING_FRACTION * sustained_speed(state)) & ~state.body_held
     if turning.any():
         frequency = np.where(turning, np.maximum(frequency, walk_frequency(model, state.desired_speed)), frequency)
+        spot = turning & (state.speed <= SPOT_FRACTION * sustained_speed(state))
+        if spot.any() and math.isfinite(model.top_speed):
+            top = walk_frequency(model, np.full_like(state.desired_speed, model.top_speed))
+            frequency = np.where(spot, np.maximum(frequency, top), frequency)
     state.stride_frequency = frequency
     in_air = ~state.in_stance
     enter, fraction = advance(state.gaits, frequency, model.dt, state.in_stance)
@@ -1449,6 +1457,14 @@ violations (stuck 4 -> 3, per-stride 4 -> 4, crossings 2 -> 2); the crowds of 8 
 0.7 s more stuck at 64; 1000 spiders (seeds 0-2 / 3-5) stuck 118 / 94 -> 138 / 95 s, crossing frames
 13 / 19 -> 19 / 18 (per-seed spread +-50 %)."""
 
+
+SPOT_FRACTION = 0.25
+"""A body turning on the spot (:func:`stage_gait`) whose speed is at most this fraction of the speed it heads
+for steps at the tempo of its top walk (``CrowdModel.top_speed``, Froude 0.5: a quadruped 1.83 Hz against
+0.98 Hz at 0.3 m/s). Measured 2026-11-29 (docs/crowds.md): the crowds issue's bar sets 4000 / 8000 / 9000,
+failing runs 2 / 1 / 2 -> 0 / 0 / 1. For every turning body (no speed bound), stuck runs fell to 0 but the
+quadrupeds' strides broke the per-stride bar in 14 runs: a body walking at 0.16 m/s at the top walk's
+tempo takes strides half the law's; 0.1 left the quadruped of 8008 stuck 4.0 s (it turns while creeping)."""
 
 STALL_S = 1.0
 """s a body its legs keep at rest while it asks to walk before its needle turns on without it, at the tempo
