@@ -1462,7 +1462,8 @@ SPOT_FRACTION = 0.25
 """A body turning on the spot (:func:`stage_gait`) whose speed is at most this fraction of the speed it heads
 for steps at the tempo of its top walk (``CrowdModel.top_speed``, Froude 0.5: a quadruped 1.83 Hz against
 0.98 Hz at 0.3 m/s). Measured 2026-11-29 (docs/crowds.md): the crowds issue's bar sets 4000 / 8000 / 9000,
-failing runs 2 / 1 / 2 -> 0 / 0 / 1. For every turning body (no speed bound), stuck runs fell to 0 but the
+failing runs 2 / 1 / 2 -> 0 / 0 / 1, and on the set 10000, run only once the rule was chosen, 1 -> 2 (stuck
+s over the four 10.5 -> 5.3; the quadrupeds' per-stride p90 lower in each). For every turning body (no speed bound), stuck runs fell to 0 but the
 quadrupeds' strides broke the per-stride bar in 14 runs: a body walking at 0.16 m/s at the top walk's
 tempo takes strides half the law's; 0.1 left the quadruped of 8008 stuck 4.0 s (it turns while creeping)."""
 
