@@ -1420,11 +1420,12 @@ def stage_gait(model: CrowdModel, state: CrowdState):
     # (a right of way given and lapsing) it turned after it again without walking (crates-moving,
     # seeds 4000 and 8008: stuck 4.1 and 4.3 s).
     ctl = model.controller
+    sustained = sustained_speed(state)
     turning = np.abs(state.turn_wanted) >= TURNING_FRACTION * ctl.turn_rate * model.dt
-    turning &= (state.speed < TURNING_FRACTION * sustained_speed(state)) & ~state.body_held
+    turning &= (state.speed < TURNING_FRACTION * sustained) & ~state.body_held
     if turning.any():
         frequency = np.where(turning, np.maximum(frequency, walk_frequency(model, state.desired_speed)), frequency)
-        spot = turning & (state.speed <= SPOT_FRACTION * sustained_speed(state))
+        spot = turning & (state.speed <= SPOT_FRACTION * sustained)
         if spot.any() and math.isfinite(model.top_speed):
             top = walk_frequency(model, np.full_like(state.desired_speed, model.top_speed))
             frequency = np.where(spot, np.maximum(frequency, top), frequency)
