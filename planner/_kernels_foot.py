@@ -97,6 +97,16 @@ MIN_STEP_CELLS = 1e-3
 # the neighbour, and whether it did depended on how (x - origin) / cell rounds.
 END_PULLBACK_M = 1e-9
 PUSH_BEYOND_M = 1e-9  # a footprint pushed out of another foot's room ends this far beyond it (out_of_other_feet)
+SOURCE_GRACE = 0.5
+"""x the foot's room (``feet_block_radius``, two half-diagonals of the foot): a swing's chord may pass a
+cell of another leg's projection or another foot's room (``OTHER_LEG``) where it meets that cell only
+within this distance of its source, the half-diagonal of the foot standing there (the disc the foot
+covers in any yaw). A path so graced is then checked on the geometry: it crosses no other leg
+(:func:`path_crosses_legs`). Cells are 7 cm: a source on a cell's border, beside such a cell, refused
+the straight way that grazed the cell's corner by 1 mm for 1.5 cm, and the path's first kept point was
+the centre of the cell behind, 4 cm back and out; the knee swept across the neighbouring leg's
+(spider, ``stairs@terrain.rise=0.1,terrain.run=0.3``, spawn 0.45, seed 502, frame 130)."""
+GRACED = 2  # segment_clear: clear thanks to SOURCE_GRACE
 LEG_CLEARANCE = 0.5
 """x the foot's room (``feet_block_radius``): the least distance between a footprint and every other leg
 (hip -> foot), and between every other foot and the leg to the footprint (the leg-gap feature). A leg
@@ -618,30 +628,73 @@ def _pulled_back(ax, az, bx, bz):
     return bx - back * (bx - ax), bz - back * (bz - az)
 
 
+@nb.njit(cache=True, inline="always")
+def _within_source_grace(ax, az, bx, bz, cx, cz, half, sx, sz, grace):
+    """The part of segment a-b inside the closed square of centre (cx, cz), half side ``half``, lies within
+    ``grace`` of the source (sx, sz): Liang-Barsky clipping, then both ends of the clipped part in the
+    disc (a disc is convex). A segment that misses the square (by rounding) is not forgiven."""
+    t0 = 0.0
+    t1 = 1.0
+    dx = bx - ax
+    dz = bz - az
+    for k in range(4):
+        if k == 0:
+            p, q = -dx, ax - (cx - half)
+        elif k == 1:
+            p, q = dx, (cx + half) - ax
+        elif k == 2:
+            p, q = -dz, az - (cz - half)
+        else:
+            p, q = dz, (cz + half) - az
+        if p == 0.0:
+            if q < 0.0:
+                return False  # (rounding: the supercover met the cell) not forgiven
+            continue
+        t = q / p
+        if p < 0.0:
+            t0 = max(t0, t)
+        else:
+            t1 = min(t1, t)
+        if t0 > t1:
+            return False
+    return (math.hypot(ax + t0 * dx - sx, az + t0 * dz - sz) <= grace
+            and math.hypot(ax + t1 * dx - sx, az + t1 * dz - sz) <= grace)
+
+
 @nb.njit(cache=True)
-def segment_clear(ax, az, bx, bz, passable, source_p, r0, c0, hp, wp, origin_x, origin_z, cell, rows, cols):
-    """Line of sight: every cell the segment touches is passable (or the source cell)."""
+def segment_clear(ax, az, bx, bz, passable, code, source_p, source_x, source_z, grace, r0, c0, hp, wp, origin_x, origin_z,
+                  cell, rows, cols):
+    """Line of sight: every cell the segment touches is passable (or the source cell). Returns 0 (blocked),
+    1 (clear) or :data:`GRACED` (clear but for cells of another leg or foot met only within ``grace`` of the
+    source, :data:`SOURCE_GRACE`)."""
     m = supercover_visit(ax, az, bx, bz, origin_x, origin_z, cell, rows, cols)
     if m >= rows.size:
-        return False
+        return 0
+    out = 1
     for k in range(m):
         rr = rows[k] - r0 + 1
         cc = cols[k] - c0 + 1
         if rr < 1 or rr >= hp - 1 or cc < 1 or cc >= wp - 1:
-            return False
+            return 0
         p = rr * wp + cc
         if p != source_p and not passable[p]:
-            return False
-    return True
+            if code[p] != OTHER_LEG or grace <= 0.0:
+                return 0
+            cx, cz = cell_centre(rows[k], cols[k], origin_x, origin_z, cell)
+            if not _within_source_grace(ax, az, bx, bz, cx, cz, 0.5 * cell, source_x, source_z, grace):
+                return 0
+            out = GRACED
+    return out
 
 
 @nb.njit(cache=True)
-def naive_and_kept_points(parent, source_p, target_p, source_x, source_z, target_x, target_z, passable, r0, c0, hp,
-                          wp, origin_x, origin_z, cell, rows, cols):
+def naive_and_kept_points(parent, source_p, target_p, source_x, source_z, target_x, target_z, passable, code, grace, r0,
+                          c0, hp, wp, origin_x, origin_z, cell, rows, cols):
     """Naive cells of the wavefront path, refined by line of sight (§4).
 
-    Returns the kept points (k, 2) in world x, z: the exact source, the cell
-    centres kept, the exact target point (a continuous footprint inside the target cell).
+    Returns (kept, graced): the kept points (k, 2) in world x, z (the exact source, the cell centres
+    kept, the exact target point: a continuous footprint inside the target cell), and whether a kept
+    chord is clear only by the source's grace (:data:`SOURCE_GRACE`, ``grace`` in metres).
     """
     count = 1
     p = target_p
@@ -666,14 +719,17 @@ def naive_and_kept_points(parent, source_p, target_p, source_x, source_z, target
     kept_idx[0] = 0
     nk = 1
     i = 0
+    graced = False
     while i < count - 1:
         j = count - 1
         while j > i + 1:
             ex, ez = naive[j, 0], naive[j, 1]
             if j == count - 1:  # the chord to the footprint: its own cell's border is its own
                 ex, ez = _pulled_back(naive[i, 0], naive[i, 1], ex, ez)
-            if segment_clear(naive[i, 0], naive[i, 1], ex, ez, passable, source_p, r0, c0, hp, wp,
-                             origin_x, origin_z, cell, rows, cols):
+            clear = segment_clear(naive[i, 0], naive[i, 1], ex, ez, passable, code, source_p, source_x, source_z,
+                                  grace, r0, c0, hp, wp, origin_x, origin_z, cell, rows, cols)
+            if clear:
+                graced = graced or clear == GRACED
                 break
             j -= 1
         kept_idx[nk] = j
@@ -683,7 +739,7 @@ def naive_and_kept_points(parent, source_p, target_p, source_x, source_z, target
     for k in range(nk):
         kept[k, 0] = naive[kept_idx[k], 0]
         kept[k, 1] = naive[kept_idx[k], 1]
-    return kept
+    return kept, graced
 
 
 @nb.njit(cache=True)
@@ -804,19 +860,24 @@ def resample_by_arclength(poly, n_poly, k, out):
 
 
 @nb.njit(cache=True)
-def path_2d(kept, passable, dt, elev_dil, code, source_p, target_p, r0, c0, hp, wp, origin_x, origin_z, cell, dense,
-            dense_p, g_free, rows, cols):
+def path_2d(kept, passable, dt, elev_dil, code, source_p, target_p, grace, r0, c0, hp, wp, origin_x, origin_z, cell,
+            dense, dense_p, g_free, rows, cols):
     """2D Hermite path through the kept points, verified chord by chord.
 
     Tries Catmull-Rom tangents, then halved, then zero tangents (the refined
     polyline, clear by line of sight). Fills dense[:, :2] and dense_p (ROI index of
     each sample), G in dense[:, 2] and ``g_free`` (G over the cells clear of forbidden boxes
-    only, :func:`drawn_heights`). Returns (n_dense, length_2d, curvature_energy, clearance_m);
-    n_dense = -1 if none fits.
+    only, :func:`drawn_heights`). Chords from the source ``kept[0]`` have its grace (``grace`` m,
+    :data:`SOURCE_GRACE`). Returns (n_dense, length_2d, curvature_energy, clearance_m, graced);
+    n_dense = -1 if none fits; graced: a chord is clear only by the source's grace.
     """
     chord_max = DENSE_SPACING_MAX * cell
+    source_x = kept[0, 0]
+    source_z = kept[0, 1]
     n = -1
+    graced = False
     for attempt in range(3):
+        graced = False
         tau = 1.0 if attempt == 0 else (0.5 if attempt == 1 else 0.0)
         n = hermite_dense(kept, tau, cell, dense)
         if n < 0:
@@ -840,15 +901,17 @@ def path_2d(kept, passable, dt, elev_dil, code, source_p, target_p, r0, c0, hp, 
                 ex, ez = dense[i, 0], dense[i, 1]
                 if i == n - 1:
                     ex, ez = _pulled_back(dense[i - 1, 0], dense[i - 1, 1], ex, ez)
-                if not segment_clear(dense[i - 1, 0], dense[i - 1, 1], ex, ez, passable, source_p,
-                                     r0, c0, hp, wp, origin_x, origin_z, cell, rows, cols):
+                clear = segment_clear(dense[i - 1, 0], dense[i - 1, 1], ex, ez, passable, code, source_p, source_x,
+                                      source_z, grace, r0, c0, hp, wp, origin_x, origin_z, cell, rows, cols)
+                if not clear:
                     ok = False
                     break
+                graced = graced or clear == GRACED
         if ok:
             break
         n = -1
     if n < 2:
-        return -1, 0.0, 0.0, 0.0
+        return -1, 0.0, 0.0, 0.0, False
     cum = np.empty(n, dtype=np.float64)
     cum[0] = 0.0
     for i in range(1, n):
@@ -863,8 +926,11 @@ def path_2d(kept, passable, dt, elev_dil, code, source_p, target_p, r0, c0, hp, 
         # or in the source cell when it is (a box moved onto the foot) are at 0 from a blocked cell by
         # definition: counting them scored every such footprint's path at clearance 0, and a spider's
         # middle-rear foot landed a cell short of its preferred footprint every other stride.
+        # Samples in a cell the source's grace lets the path pass are at 0 by definition too.
         p = dense_p[i]
-        if not ((p == target_p or p == source_p) and dt[p] == 0.0):
+        in_grace = (code[p] == OTHER_LEG and not passable[p]
+                    and math.hypot(dense[i, 0] - source_x, dense[i, 1] - source_z) <= grace)
+        if not ((p == target_p or p == source_p or in_grace) and dt[p] == 0.0):
             clearance = min(clearance, dt[p])
         if u < U_LO or u > U_HI:
             continue
@@ -897,7 +963,7 @@ def path_2d(kept, passable, dt, elev_dil, code, source_p, target_p, r0, c0, hp, 
                     gf = max(gf, elev_dil[q])
         dense[i, 2] = g
         g_free[i] = gf
-    return n, length, length * integral, clearance
+    return n, length, length * integral, clearance, graced
 
 
 @nb.njit(cache=True)
@@ -1015,21 +1081,25 @@ def path_length_3d(poly, n):
 @nb.njit(cache=True)
 def couple_metrics_2d(parent, passable, dt, elev_dil, code, source_p, target_p, source_x, source_y, source_z, target_x,
                       target_y, target_z, step_height, r0, c0, hp, wp, origin_x, origin_z, cell, dense, dense_p, g_free,
-                      rows, cols):
+                      rows, cols, other_legs, grace):
     """The 2D part of a (target, slice) couple: the path from the slice's wavefront tree, its
     2D metrics, and the 2D climb over the elevations under the path (the 3D trajectory stays
     above them, so climb_3d >= climb_2d, and with length_3d >= length_2d, score_3d <= score_2d).
-    ``code`` (the ROI's cell codes) and ``g_free`` (filled) as in :func:`path_2d`.
+    ``code`` (the ROI's cell codes) and ``g_free`` (filled) as in :func:`path_2d`; a path clear
+    only by its source's grace (``grace`` m, :data:`SOURCE_GRACE`) crosses no row of ``other_legs``.
     Returns (n_dense, length_2d, curvature, clearance, climb_2d); n_dense < 2: no path."""
     # A goal-only target cell (next to another leg, see footprint_candidates) is passable for
     # the path that ends in it, and only for that path.
     was = passable[target_p]
     passable[target_p] = 1
-    kept = naive_and_kept_points(parent, source_p, target_p, source_x, source_z, target_x, target_z, passable, r0, c0,
-                                 hp, wp, origin_x, origin_z, cell, rows, cols)
-    nd, len2, curv, clear = path_2d(kept, passable, dt, elev_dil, code, source_p, target_p, r0, c0, hp, wp, origin_x,
-                                    origin_z, cell, dense, dense_p, g_free, rows, cols)
+    kept, graced_kept = naive_and_kept_points(parent, source_p, target_p, source_x, source_z, target_x, target_z,
+                                              passable, code, grace, r0, c0, hp, wp, origin_x, origin_z, cell, rows,
+                                              cols)
+    nd, len2, curv, clear, graced = path_2d(kept, passable, dt, elev_dil, code, source_p, target_p, grace, r0, c0, hp,
+                                            wp, origin_x, origin_z, cell, dense, dense_p, g_free, rows, cols)
     passable[target_p] = was
+    if nd >= 2 and (graced or graced_kept) and path_crosses_legs(dense, nd, 1, other_legs):
+        nd = -1
     if nd < 2:
         return nd, 0.0, 0.0, 0.0, 0.0
     ground_top = -np.inf

@@ -72,6 +72,7 @@ from footfall.planner._kernels_foot import (
     RAW_CURVATURE,
     RAW_JERK,
     RAW_LENGTH,
+    SOURCE_GRACE,
     couple_metrics_2d,
     couple_metrics_3d,
     drawn_heights,
@@ -185,6 +186,7 @@ def plan_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, foot_shap
     source_x = source[0]
     source_y = source[1]
     source_z = source[2]
+    grace = SOURCE_GRACE * feet_block_radius
     counters = np.zeros(N_COUNTERS, dtype=np.int64)
     (code, elev_dil, boxh_dil, r0, c0, hp, wp, source_p, cand, cand_terms, cand_scores, _, cand_rc, levels,
      d_ref, cand_xz, in_reach) = foot_setup(elevation, ground, forbidden, origin_x, origin_z, foot_shape, source,
@@ -288,7 +290,8 @@ def plan_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, foot_shap
                     continue
                 nd, len2, curv, clear, climb2 = couple_metrics_2d(
                     parent[s], passable[s], dt[s], elev_dil, code, source_p, tp, source_x, source_y, source_z, tx, target_y,
-                    tz, step_height, r0, c0, hp, wp, origin_x, origin_z, cell, dense, dense_p, g_free, rows, cols)
+                    tz, step_height, r0, c0, hp, wp, origin_x, origin_z, cell, dense, dense_p, g_free, rows, cols,
+                    other_legs, grace)
                 if nd < 2 or (boxed and _boxed_way_refused(dense, nd, 1, other_legs, forbidden, origin_x, origin_z,
                                                            cell, foot_shape)):
                     continue
@@ -392,6 +395,7 @@ def harvest_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, foot_s
     source_x = source[0]
     source_y = source[1]
     source_z = source[2]
+    grace = SOURCE_GRACE * feet_block_radius
     (code, elev_dil, boxh_dil, r0, c0, hp, wp, source_p, cand, cand_terms, cand_scores, cand_features, cand_rc, levels,
      d_ref, cand_xz, in_reach) = foot_setup(elevation, ground, forbidden, origin_x, origin_z, foot_shape, source,
                                             preferred, hip, reach_xz, other_legs, feet_block_radius, w, cfg,
@@ -437,7 +441,7 @@ def harvest_foot_kernel(elevation, ground, forbidden, origin_x, origin_z, foot_s
             nd, len2, curv, clear, climb2 = couple_metrics_2d(
                 parent, passable, dt, elev_dil, code, source_p, tp, source_x, source_y, source_z, cand_xz[k, 0],
                 target_y, cand_xz[k, 1], step_height, r0, c0, hp, wp, origin_x, origin_z, cell, dense, dense_p, g_free,
-                rows, cols)
+                rows, cols, other_legs, grace)
             if nd < 2:
                 continue
             len3, climb3, jerk = couple_metrics_3d(dense, nd, len2, source_y, target_y, step_height,

@@ -77,6 +77,7 @@ DENSE_SPACING_MAX = 0.40  # no chord between samples longer than this (cells)
 JERK_SAMPLES = 48  # constant arc-length samples of the jerk integral
 U_LO, U_HI = 0.05, 0.95  # curvature and jerk are integrated over u in [U_LO, U_HI]
 MAX_SLICES = 12
+SOURCE_GRACE = 0.5  # x the foot's room: a chord may meet another leg's cell within this of its source
 
 FREE, FORBIDDEN, SIZE_INCREASE, OTHER_LEG = range(4)
 
@@ -165,14 +166,15 @@ def proper_crossing(a, b, c, d):
     return orient(a, b, c) * orient(a, b, d) < 0 and orient(c, d, a) * orient(c, d, b) < 0
 
 
-def segment_touches_square(ax, az, bx, bz, x0, x1, z0, z1, tol=1e-12):
-    """The closed segment meets the closed square [x0, x1] x [z0, z1] (Liang-Barsky clipping)."""
+def segment_clip_to_square(ax, az, bx, bz, x0, x1, z0, z1, tol=0.0):
+    """The part of the closed segment a-b in the closed square [x0, x1] x [z0, z1] (grown by ``tol``), as its
+    two end points, or None (Liang-Barsky clipping)."""
     t0, t1 = 0.0, 1.0
     for p, q in ((-(bx - ax), ax - (x0 - tol)), (bx - ax, (x1 + tol) - ax),
                  (-(bz - az), az - (z0 - tol)), (bz - az, (z1 + tol) - az)):
         if p == 0.0:
             if q < 0.0:
-                return False
+                return None
             continue
         t = q / p
         if p < 0.0:
@@ -180,8 +182,13 @@ def segment_touches_square(ax, az, bx, bz, x0, x1, z0, z1, tol=1e-12):
         else:
             t1 = min(t1, t)
         if t0 > t1:
-            return False
-    return True
+            return None
+    return [(ax + t * (bx - ax), az + t * (bz - az)) for t in (t0, t1)]
+
+
+def segment_touches_square(ax, az, bx, bz, x0, x1, z0, z1, tol=1e-12):
+    """The closed segment meets the closed square [x0, x1] x [z0, z1] (Liang-Barsky clipping)."""
+    return segment_clip_to_square(ax, az, bx, bz, x0, x1, z0, z1, tol) is not None
 
 
 def cells_touched(ax, az, bx, bz, ox, oz, cell, n_rows, n_cols):
@@ -480,12 +487,25 @@ class Oracle:
             back = 1e-9 / d if d > 0 else 0.0
             cells = cells_touched(ax, az, bx - back * (bx - ax), bz - back * (bz - az), self.ox, self.oz, self.cell,
                                   self.n_rows, self.n_cols)
+        out = 1
         for r, c in cells:
             if not (0 <= r < self.n_rows and 0 <= c < self.n_cols):
-                return False
+                return 0
             if (r, c) != self.src_rc and not passable[r, c]:
-                return False
-        return True
+                if not self._in_source_grace(ax, az, bx, bz, r, c):
+                    return 0
+                out = 2
+        return out
+
+    def _in_source_grace(self, ax, az, bx, bz, r, c):
+        """Cell (r, c) is another leg's or foot's, and the chord a-b meets its closed square only within the
+        source's grace (SOURCE_GRACE x the foot's room: the standing foot's half-diagonal) of the source."""
+        if self.code[r, c] != OTHER_LEG:
+            return False
+        x0, z0 = self.ox + c * self.cell, self.oz + r * self.cell
+        clip = segment_clip_to_square(ax, az, bx, bz, x0, x0 + self.cell, z0, z0 + self.cell)
+        grace = SOURCE_GRACE * self.q.feet_block_radius
+        return clip is not None and all(math.hypot(x - self.src_x, z - self.src_z) <= grace for x, z in clip)
 
     def _kept(self, naive_cells, target_pt, passable):
         """Refine the naive cells by line of sight: from each kept point, the farthest visible one."""
@@ -535,9 +555,10 @@ class Oracle:
             chords = np.linalg.norm(np.diff(dense, axis=0), axis=1)
             if (chords > DENSE_SPACING_MAX * cell).any():
                 continue
-            if all(self._clear(*dense[i - 1], *dense[i], passable, i == n - 1) for i in range(1, n)):
-                return dense, cells
-        return None, None
+            clear = [self._clear(*dense[i - 1], *dense[i], passable, i == n - 1) for i in range(1, n)]
+            if all(clear):
+                return dense, cells, 2 in clear
+        return None, None, False
 
     def _border_assignments(self, dense, cells):
         """Every assignment of the samples to cells, the documented one first: a sample within BORDER_TOL of
@@ -564,9 +585,15 @@ class Oracle:
         samples to cells (:meth:`_border_assignments`), [None] when no 2D path fits."""
         passable = sl["passable"].copy()
         passable[cand["cell"]] = True  # the path may end in its target (a goal-only cell too)
-        dense, cells = self._path_2d(kept, passable, cand["cell"])
+        dense, cells, graced = self._path_2d(kept, passable, cand["cell"])
         if dense is None or len(dense) < 2:
             return [None]
+        last = len(kept) - 1
+        graced |= any(self._clear(*kept[i], *kept[i + 1], passable, i + 1 == last) == 2 for i in range(last))
+        legs = [leg[:4] for leg in self.q.kernel_legs]
+        if graced and any(proper_crossing(dense[i], dense[i + 1], (hx, hz), (fx, fz))
+                          for i in range(len(dense) - 1) for hx, hz, fx, fz in legs):
+            return [None]  # a path clear only by its source's grace crosses no other leg
         return [self._couple_along(cand, sl, kept, passable, dense, alt)
                 for alt in self._border_assignments(dense, cells)]
 
@@ -579,9 +606,17 @@ class Oracle:
         length2d = cum[-1]
         # Clearance: the least distance to a blocked cell over the interior samples, but for those in the
         # source's or the footprint's own cell when that cell is blocked (they are at 0 by definition).
+        # The same for samples in a cell of another leg that the source's grace lets the path pass.
         own = {self.src_rc, cells[-1]}
+        grace = SOURCE_GRACE * q.feet_block_radius
+
+        def graced(i):
+            return (self.code[cells[i]] == OTHER_LEG and not passable[cells[i]]
+                    and math.hypot(dense[i][0] - self.src_x, dense[i][1] - self.src_z) <= grace)
+
         clear = min((sl["clearance"][cells[i]] for i in range(1, n - 1)
-                     if not (cells[i] in own and sl["clearance"][cells[i]] == 0.0)), default=sl["clearance"][cells[-1]])
+                     if not ((cells[i] in own or graced(i)) and sl["clearance"][cells[i]] == 0.0)),
+                    default=sl["clearance"][cells[-1]])
         # Curvature energy E = L * integral kappa^2 ds, kappa = turning angle / mean adjacent chord.
         integral = 0.0
         for i in range(1, n - 1):
@@ -993,6 +1028,47 @@ def test_moving_the_world_by_a_metre_moves_the_footprint_by_a_metre():
         r = plan_foot(maps, query, budget=EXHAUSTIVE)
         picks.append((r.target_cell, round(r.target[0] - ox, 9), round(r.couple_score, 9)))
     assert picks[0] == picks[1]
+
+
+def _graze_scene(source_z):
+    """14 x 14 cells of 7 cm, flat, no box. The foot (3 x 2 cm: room hypot(0.03, 0.02) = 3.61 cm, grace
+    1.80 cm) stands at (0.4199, ``source_z``), 0.1 mm inside cell (6, 5)'s east border x = 0.42, and
+    prefers (0.60, 0.501) in cell (7, 8). Another leg, hip (0.55, 0.30) -> foot (0.47, 0.43): the only
+    cell of its foot's room on the way is (6, 6), x in [0.42, 0.49], z in [0.42, 0.49] (its centre
+    (0.455, 0.455) is 2.9 cm from that foot)."""
+    n, cell = 14, 0.07
+    flat = np.zeros((n, n))
+    maps = LocalMaps(GridFrame(0.0, 0.0, cell, n, n), flat, flat.copy(), np.zeros((n, n), np.uint8))
+    query = FootQuery(source=(0.4199, 0.0, source_z), preferred=(0.60, 0.501), hip=(0.50, 0.75), reach_xz=0.7,
+                      step_height=0.05, foot_length=0.03, foot_width=0.02, foot_yaw=0.0,
+                      other_legs=np.array([[0.55, 0.30, 0.47, 0.43]]))
+    return maps, query
+
+
+def test_a_swing_grazing_another_legs_cell_beside_its_source_goes_straight():
+    # Source z = 0.489: the straight way to (0.60, 0.501) rises 1.2 cm over 18 cm, so it leaves row 6 at
+    # z = 0.49 after 1.5 cm, having met cell (6, 6) only within 1.50 cm of its source (< the grace, 1.80 cm).
+    # It is the couple's path: 2D length = the straight distance. Without the grace that cell refused it;
+    # the way ran through the centre of (7, 5), (0.385, 0.525), 3.5 cm back and 3.6 cm out, and the foot
+    # took a 1 cm step to (0.42, 0.501) instead (score 0.850 against 0.961).
+    maps, query = _graze_scene(0.489)
+    h = harvest_foot(maps, query, budget=EXHAUSTIVE)
+    k = [tuple(rc) for rc in h.cand_cells.tolist()].index((7, 8))
+    straight = math.hypot(0.60 - 0.4199, 0.501 - 0.489)
+    assert h.couple_valid[k, 0] and h.couple_raw[k, 0, 0] == pytest.approx(straight, abs=1e-12)
+    result = plan_foot(maps, query, budget=EXHAUSTIVE)
+    assert result.target_cell == (7, 8)
+    assert (result.target[0], result.target[2]) == pytest.approx((0.60, 0.501), abs=1e-12)
+    way = result.trajectory[:, [0, 2]] - result.trajectory[0, [0, 2]]
+    assert (way @ np.array([0.60 - 0.4199, 0.501 - 0.489]) / straight).min() >= -1e-12, "the swing starts backwards"
+    cand, _, variants = _oracle_best(maps, query)
+    assert cand["cell"] == (7, 8) and abs(result.couple_score - variants[0]["score"]) <= SCORE_TOL
+    # Source z = 0.4865: the way leaves row 6 only after 4.3 cm (z rises 1.45 cm over 18 cm), so it meets
+    # (6, 6) beyond the grace: refused, the couple's path bends round the cell (longer than straight).
+    maps, query = _graze_scene(0.4865)
+    h = harvest_foot(maps, query, budget=EXHAUSTIVE)
+    k = [tuple(rc) for rc in h.cand_cells.tolist()].index((7, 8))
+    assert h.couple_raw[k, 0, 0] > math.hypot(0.60 - 0.4199, 0.501 - 0.4865) + 0.005
 
 
 def test_a_leg_over_a_boxs_ring_does_not_let_the_foot_onto_the_box():
