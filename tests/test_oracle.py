@@ -1071,6 +1071,24 @@ def test_a_swing_grazing_another_legs_cell_beside_its_source_goes_straight():
     assert h.couple_raw[k, 0, 0] > math.hypot(0.60 - 0.4199, 0.501 - 0.4865) + 0.005
 
 
+def test_a_swing_clear_only_by_its_sources_grace_crosses_no_leg():
+    # The first scene (source z = 0.489) with a leg drawn bent (planner._crowd.drawn_leg_segments: no foot at
+    # its end) from (0.421, 0.43) to (0.428, 0.4897), in cell (6, 6) alone. The straight way to (0.60, 0.501)
+    # is at z = 0.489 + 0.0081 x 0.012 / 0.1801 = 0.48954 at x = 0.428, below the segment's end: it crosses
+    # the leg 0.8 cm from its source, inside the grace, so the cells let it pass and the geometry refuses it.
+    # (7, 8) then has no couple, and the foot lands on (8, 8), (0.60, 0.56), as the oracle's; without the
+    # check the runtime swung across the leg to (7, 8).
+    maps, query = _graze_scene(0.489)
+    query = dataclasses.replace(query, drawn_segments=np.array([[0.421, 0.43, 0.428, 0.4897]]))
+    h = harvest_foot(maps, query, budget=EXHAUSTIVE)
+    k = [tuple(rc) for rc in h.cand_cells.tolist()].index((7, 8))
+    assert not h.couple_valid[k].any()
+    result = plan_foot(maps, query, budget=EXHAUSTIVE)
+    cand, _, variants = _oracle_best(maps, query)
+    assert result.target_cell == cand["cell"] == (8, 8)
+    assert abs(result.couple_score - variants[0]["score"]) <= SCORE_TOL
+
+
 def test_a_leg_over_a_boxs_ring_does_not_let_the_foot_onto_the_box():
     # The preferred footprint (0.625, 0.51) lies in the size-increase cell (7, 8): a foot there
     # (x in [0.61, 0.64], z in [0.50, 0.52]) overlaps the forbidden cell (7, 9) by 1 cm in x. Without
