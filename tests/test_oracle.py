@@ -841,12 +841,46 @@ def random_case(rng):
     return LocalMaps(frame, elevation, ground, forbidden), query, weights
 
 
-def draw_case(seed):
+def draw_case(seed, border=False):
+    """:func:`random_case` of ``seed``; with ``border``, turned by :func:`border_case` (its own stream)."""
     rng = np.random.default_rng(seed)
     while True:
         case = random_case(rng)
         if case is not None:
-            return case
+            return border_case(*case, np.random.default_rng([seed, 7])) if border else case
+
+
+def border_case(maps, query, weights, rng):
+    """The case with its foot moved 0.1 mm inside a border of its cell and, across that border, another
+    foot whose room takes the neighbouring cell, so that a swing may graze that cell beside its source
+    (planner._kernels_foot.SOURCE_GRACE; a foot planned onto a cell's border stands there next). The
+    source's own cell stays clear of the new leg and of its foot's room, as in :func:`random_case`."""
+    f = maps.frame
+    ox, oz = f.origin_x, f.origin_z
+    sx, sy, sz = (float(v) for v in query.source)
+    r, c = cell_of(sx, sz, ox, oz, CELL)
+    axis, side = int(rng.integers(2)), float(rng.choice([-1.0, 1.0]))
+    if axis == 0:
+        sx = ox + (c + (side > 0)) * CELL - side * 1e-3
+        nr, nc = r, c + int(side)
+    else:
+        sz = oz + (r + (side > 0)) * CELL - side * 1e-3
+        nr, nc = r + int(side), c
+    query = dataclasses.replace(query, source=(sx, sy, sz))
+    radius = query.feet_block_radius
+    nx, nz = cell_centre(nr, nc, ox, oz, CELL)
+    cx, cz = cell_centre(r, c, ox, oz, CELL)
+    for _try in range(20):
+        away, along = 0.7 * radius * rng.uniform(0.0, 1.0, size=2) * (1.0, rng.choice([-1.0, 1.0]))
+        fx, fz = (nx + side * away, nz + along) if axis == 0 else (nx + along, nz + side * away)
+        a = math.atan2(fz - sz, fx - sx) + rng.uniform(-0.8, 0.8)
+        length = rng.uniform(0.15, 0.35)
+        hx, hz = fx + length * math.cos(a), fz + length * math.sin(a)
+        if ((r, c) not in cells_touched(hx, hz, fx, fz, ox, oz, CELL, N, N)
+                and math.hypot(cx - fx, cz - fz) > radius):
+            legs = np.vstack([query.other_legs.reshape(-1, 4), [[hx, hz, fx, fz]]])
+            return maps, dataclasses.replace(query, other_legs=legs), weights
+    return maps, query, weights
 
 
 def _describe(couple):
@@ -867,8 +901,8 @@ def roi_is_the_map(maps, query, config):
 
 
 @functools.lru_cache(maxsize=None)
-def _search_and_oracle(seed):
-    maps, query, weights = draw_case(seed)
+def _search_and_oracle(seed, border=False):
+    maps, query, weights = draw_case(seed, border)
     config = PlannerConfig()
     assert roi_is_the_map(maps, query, config), f"seed {seed}: the case is larger than the search's region"
     oracle = Oracle(maps, query, weights, config, EXHAUSTIVE.slice_size_m)
@@ -876,20 +910,26 @@ def _search_and_oracle(seed):
     return maps, query, weights, oracle, oracle.couples(), result
 
 
+@pytest.mark.parametrize("border", (False, True), ids=("plain", "border"))
 @pytest.mark.parametrize("seed", fresh_seeds(FIXED_SEEDS, N_FRESH, salt=20))
-def test_exhaustive_search_picks_the_oracles_best_couple(seed):
+def test_exhaustive_search_picks_the_oracles_best_couple(seed, border):
     """The exhaustive search's couple is the oracle's argmax: same cell, point, slice and score; its
     breakdown and raw metrics are the oracle's. Ties are explicit: couples within SCORE_TOL of the best
-    are all acceptable, and a couple with tied shortest paths may score any of its paths' scores."""
-    _, _, _, oracle, couples, result = _search_and_oracle(seed)
-    where = f"seed {seed}"
+    are all acceptable, and a couple with tied shortest paths may score any of its paths' scores.
+    ``border``: the case's foot on a border of its cell, another foot's room across it
+    (:func:`border_case`; a quarter of them have a path that grazes that room beside its source)."""
+    _, _, _, oracle, couples, result = _search_and_oracle(seed, border)
+    where = f"seed {seed}" + (" (border case)" if border else "")
 
     def lo(variants):  # the couple's score whichever tied path the search follows (-inf: maybe no path)
         return min(-math.inf if v is None else v["score"] for v in variants)
 
     possible = [c for c in couples if any(v is not None for v in c[2])]
     if not possible:
-        assert not result.valid, f"{where}: the oracle has no couple, the search found {result.target_cell}"
+        # No couple: the search agrees, or its boxed-in foot's way out found one (planner._kernels_foot.
+        # BOXED_CELL_COST: a fallback through other feet's room, which the oracle does not model).
+        assert not result.valid or result.counters["boxed_ways"] == 1, \
+            f"{where}: the oracle has no couple, the search found {result.target_cell}"
         return
     best = max(lo(c[2]) for c in couples)
     if not result.valid:
@@ -916,13 +956,14 @@ def test_exhaustive_search_picks_the_oracles_best_couple(seed):
                                err_msg=where)
 
 
+@pytest.mark.parametrize("border", (False, True), ids=("plain", "border"))
 @pytest.mark.parametrize("seed", fresh_seeds(FIXED_SEEDS, N_FRESH, salt=21))
-def test_every_couple_scores_as_the_oracle_says(seed):
+def test_every_couple_scores_as_the_oracle_says(seed, border):
     """Not only the winner: every candidate (cell, point, features, goodnesses, footprint score), the
     slice levels, and every (candidate, slice) couple of the runtime's harvest (valid or not, its score)
-    are the oracle's."""
-    maps, query, weights, oracle, couples, _ = _search_and_oracle(seed)
-    where = f"seed {seed}"
+    are the oracle's (``border``: as in the test above)."""
+    maps, query, weights, oracle, couples, _ = _search_and_oracle(seed, border)
+    where = f"seed {seed}" + (" (border case)" if border else "")
     h = harvest_foot(maps, query, weights=weights, budget=EXHAUSTIVE, config=PlannerConfig())
     mine = {c["cell"]: c for c in oracle.candidates}
     theirs = {(int(r), int(c)): k for k, (r, c) in enumerate(h.cand_cells)}
