@@ -24,7 +24,13 @@ import numba as nb
 import numpy as np
 
 from footfall.planner._grid import cell_centre, cell_of
-from footfall.planner._kernels_geometry import rect_overlaps_aabb, segment_point_distance, segments_cross, supercover_visit
+from footfall.planner._kernels_geometry import (
+    rect_overlaps_aabb,
+    segment_point_distance,
+    segment_square_clip,
+    segments_cross,
+    supercover_visit,
+)
 from footfall.planner._kernels_wavefront import chamfer_distance
 from footfall.planner._weights import (
     N_FOOTPRINT_TERMS,
@@ -631,32 +637,13 @@ def _pulled_back(ax, az, bx, bz):
 @nb.njit(cache=True, inline="always")
 def _within_source_grace(ax, az, bx, bz, cx, cz, half, sx, sz, grace):
     """The part of segment a-b inside the closed square of centre (cx, cz), half side ``half``, lies within
-    ``grace`` of the source (sx, sz): Liang-Barsky clipping, then both ends of the clipped part in the
-    disc (a disc is convex). A segment that misses the square (by rounding) is not forgiven."""
-    t0 = 0.0
-    t1 = 1.0
+    ``grace`` of the source (sx, sz): both ends of the clipped part in the disc (a disc is convex). A
+    segment that misses the square (by rounding: the supercover met the cell) is not forgiven."""
+    t0, t1 = segment_square_clip(ax, az, bx, bz, cx, cz, half)
+    if t0 > t1:
+        return False
     dx = bx - ax
     dz = bz - az
-    for k in range(4):
-        if k == 0:
-            p, q = -dx, ax - (cx - half)
-        elif k == 1:
-            p, q = dx, (cx + half) - ax
-        elif k == 2:
-            p, q = -dz, az - (cz - half)
-        else:
-            p, q = dz, (cz + half) - az
-        if p == 0.0:
-            if q < 0.0:
-                return False  # (rounding: the supercover met the cell) not forgiven
-            continue
-        t = q / p
-        if p < 0.0:
-            t0 = max(t0, t)
-        else:
-            t1 = min(t1, t)
-        if t0 > t1:
-            return False
     return (math.hypot(ax + t0 * dx - sx, az + t0 * dz - sz) <= grace
             and math.hypot(ax + t1 * dx - sx, az + t1 * dz - sz) <= grace)
 

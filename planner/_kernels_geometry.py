@@ -194,6 +194,44 @@ def segment_point_distance(px, pz, ax, az, bx, bz):
 
 
 @nb.njit(cache=True)
+def segment_square_clip(ax, az, bx, bz, cx, cz, half):
+    """(t0, t1): the part of segment a-b (a + t (b - a), t in [0, 1]) inside the closed square of centre
+    (cx, cz) and half side ``half`` (Liang-Barsky clipping); t0 > t1 when the segment misses it.
+
+    >>> segment_square_clip(-1.0, 0.5, 2.0, 0.5, 0.5, 0.5, 0.5)  # x from -1 to 2 across [0, 1]
+    (0.3333333333333333, 0.6666666666666666)
+    >>> t0, t1 = segment_square_clip(-1.0, 2.0, 2.0, 2.0, 0.5, 0.5, 0.5)  # z = 2, above the square
+    >>> bool(t0 > t1)
+    True
+    """
+    t0 = 0.0
+    t1 = 1.0
+    dx = bx - ax
+    dz = bz - az
+    for k in range(4):
+        if k == 0:
+            p, q = -dx, ax - (cx - half)
+        elif k == 1:
+            p, q = dx, (cx + half) - ax
+        elif k == 2:
+            p, q = -dz, az - (cz - half)
+        else:
+            p, q = dz, (cz + half) - az
+        if p == 0.0:
+            if q < 0.0:
+                return 1.0, 0.0  # parallel to this side and outside it
+            continue
+        t = q / p
+        if p < 0.0:
+            t0 = max(t0, t)
+        else:
+            t1 = min(t1, t)
+        if t0 > t1:
+            return t0, t1
+    return t0, t1
+
+
+@nb.njit(cache=True)
 def segments_cross(ax, az, bx, bz, cx, cz, dx, dz):
     """True when segments a-b and c-d properly intersect (shared endpoints excluded)."""
     d1 = (bx - ax) * (cz - az) - (bz - az) * (cx - ax)
