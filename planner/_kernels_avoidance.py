@@ -233,8 +233,9 @@ def orca_velocities(positions, velocities, preferred, radii, max_speed, neighbou
     ``yield_radii`` (C,) m: the radius such a character keeps, for its own velocity, from one that can
     make way (less than its disc, ``planner._crowd.YIELD_RADIUS``; the other still keeps the whole disc
     round it, ``radii``); ``right_of_way`` (C,) bool: a character that has waited too long for others to pass
-    (``planner._crowd.WAIT_LIMIT_S``): between equals otherwise, the other takes the whole effort and it
-    leaves that other's half-plane out (it walks on; the other, walking, steers round it as round a box).
+    (``planner._crowd.WAIT_LIMIT_S``): against a neighbour without it and without priority, walking or
+    standing, the other takes the whole effort and it leaves that other's half-plane out (it walks on; the
+    other steers round it as round a box).
     """
     n = positions.shape[0]
     for c in nb.prange(n):
@@ -280,6 +281,11 @@ def orca_velocities(positions, velocities, preferred, radii, max_speed, neighbou
             # A character that cannot make way keeps only part of its disc from one that can: kept to
             # its whole disc, it stood while a walker went round that disc's edge and on into its way.
             combined = (yield_radii[c] if mobile[j] and not mobile[c] else ra) + radii[j]
+            # The right of way lifts a standing neighbour's half-plane too (that one makes way alone, below):
+            # kept, two quadrupeds at their discs' edge each held the other 2.4 s, the one with the right of
+            # way steering round the other as round a box (planner._crowd.wait_for_others).
+            if right_of_way[c] and not right_of_way[j] and not priority[j]:
+                continue
             if not mobile[j]:
                 share = 1.0
             elif priority[c] != priority[j]:

@@ -119,6 +119,14 @@ def test_a_character_with_the_right_of_way_walks_on_and_the_other_takes_the_whol
     t = (1.2 - 7.0 / 8.0) * (-math.sqrt(3.0) / 2.0) + (math.sqrt(3.0) / 8.0) * 0.5
     expected = np.array([7.0 / 8.0, -math.sqrt(3.0) / 8.0]) + t * np.array([-math.sqrt(3.0) / 2.0, 0.5])
     assert out[0] == pytest.approx(expected, abs=1e-12)
+    # B standing where it cannot make way (a walker at rest): the right of way still lets A walk on, where
+    # without it A takes the whole -u (the case below). B, without it, takes the whole -u too. Kept to B's
+    # line, two quadrupeds at their discs' edge stood 2.4 s, each holding the other (crates-moving, bar seed
+    # 10007: the one with the right of way had to steer round the other as round a box, and turned back
+    # and forth as the other's speed crossed MOBILE_FRACTION).
+    out = _step(*args, right_of_way=np.array([True, False]), mobile=np.array([True, False]))
+    assert out[0] == pytest.approx([1.2, 0.0], abs=1e-12)
+    assert out[1] == pytest.approx([1.0 / 4.0, math.sqrt(3.0) / 4.0], abs=1e-12)
     # Priority (escaping a moving box) comes first: B escaping, A with the right of way, A takes it all,
     # its line through v + u = (3/4, -sqrt(3)/4) along d; (1.2, 0) projects onto (3/4, -sqrt(3)/4) + s d.
     out = _step(*args, priority=np.array([False, True]), right_of_way=np.array([True, False]))
