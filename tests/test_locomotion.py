@@ -169,3 +169,41 @@ def test_duty_factor_falls_with_speed_and_the_quadruped_trots_when_fast():
     assert slow.duty_factor_mean > fast.duty_factor_mean >= 0.5 - 1e-9  # biomechanics: walk DF > 0.5
     assert slow.gait_fractions["quadruped-walk"] == 1.0
     assert fast.gait_fractions["quadruped-trot"] > 0.9
+
+
+BEETLE = __import__("pathlib").Path(__file__).parent / "data" / "creatures" / "beetle.toml"
+OFF_PREFERRED_M = 0.005  # a new swing's footprint this far from its preferred one counts as moved off it
+OFF_PREFERRED_SHARE = 0.05  # on flat ground at most this share of new swings moves off (spider 2 %, ant 0 %)
+
+
+@pytest.mark.xfail(strict=True, reason="open (session 62): a small creature's footprints leave their preferred spots "
+                   "on flat ground, 16 % of its new swings by 0.5-2.7 cm (a 5.4 cm stride): the scoring's reference "
+                   "scales are absolute metres sized for the spider (clearance_ref_m 7 cm, distance_scale_m 30 cm): "
+                   "scaled by the beetle's rest radius over the spider's (0.345), 16 % -> 0 % (docs/crowds.md, session 62)")
+def test_a_small_creature_alone_on_flat_ground_lands_on_its_preferred_footprints():
+    # One creature walking straight on flat ground, nothing near: the preferred footprint (the stride law's)
+    # is free, and each new swing should land there. The built-in creatures do (1 x 120 frames, seeds 0-2:
+    # spider 2 % of new swings more than 5 mm off, robot5 2 %, ant and quadruped 0 %); the beetle, a
+    # creature no session had tuned for, 16 %: its strides snap to its 3 cm cells (per-stride p90 0.12 on
+    # flat ground alone, 0.21 with a neighbour, 0.38 on hills).
+    import footfall.planner._crowd as crowd
+    from footfall.planner import layout
+    from footfall.scenarios import load_scenario
+    from footfall.scenarios._gait_choice import resolve_gait
+
+    scenario, creature = load_scenario("flat"), load_creature(str(BEETLE))
+    gait, _, _ = resolve_gait(None, creature)
+    off = []
+    for seed in range(3):
+        model, state = crowd.init_crowd(scenario, creature, gait, n_characters=1, seed=seed)
+        for frame in range(120):
+            plans = crowd.step(model, state).plans
+            if plans is None or plans.batch is None or frame < 10:  # the first steps leave the spawn's pose
+                continue
+            new = plans.kinds == layout.KIND_NEW_SWING
+            target, preferred = plans.result.target[new], plans.batch.preferred[new]
+            off.extend(np.hypot(target[:, 0] - preferred[:, 0], target[:, 2] - preferred[:, 1]))
+    off = np.array(off)
+    assert off.size > 100, "the premise: the beetle walks and steps"
+    share = float((off > OFF_PREFERRED_M).mean())
+    assert share <= OFF_PREFERRED_SHARE, f"{share:.0%} of {off.size} new swings land over 5 mm off; largest {off.max():.4f} m"
