@@ -2,6 +2,7 @@
 the gait schedule, and what a walking creature realises per stride."""
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -171,7 +172,7 @@ def test_duty_factor_falls_with_speed_and_the_quadruped_trots_when_fast():
     assert fast.gait_fractions["quadruped-trot"] > 0.9
 
 
-BEETLE = __import__("pathlib").Path(__file__).parent / "data" / "creatures" / "beetle.toml"
+BEETLE = Path(__file__).parent / "data" / "creatures" / "beetle.toml"
 OFF_PREFERRED_M = 0.005  # a new swing's footprint this far from its preferred one counts as moved off it
 OFF_PREFERRED_SHARE = 0.05  # on flat ground at most this share of new swings moves off (spider 2 %, ant 0 %)
 
