@@ -153,16 +153,16 @@ def run_proxy(config, workdir: str | Path, progress=None) -> dict:
 # --------------------------------------------------------------------------- CMA-ES
 
 
-def search_space(start=None):
-    """(x0, lower, upper): x = log weights (19) + log FITTED_TIMING fields (4), x0 = log of the default
-    weights and of ``start`` (a ``GaitTiming``; None: the defaults). Upper bounds keep
-    ``duty_at_rest`` < 1 and ``stride_exponent`` < 0.5 (their open ranges)."""
+def search_space(weights, start=None):
+    """(x0, lower, upper): x = log weights (19) + log FITTED_TIMING fields (4), x0 = log of ``weights``
+    (the creature's defaults, ``tuning.creature_defaults``) and of ``start`` (a ``GaitTiming``; None:
+    the defaults). Upper bounds keep ``duty_at_rest`` < 1 and ``stride_exponent`` < 0.5 (their open
+    ranges)."""
     from footfall.planner._timing import GaitTiming
-    from footfall.planner._weights import ScoringWeights
     from footfall.tuning._fit import FITTED_TIMING
 
     timing = start or GaitTiming()
-    x0 = np.log(np.concatenate([ScoringWeights().to_array(), [getattr(timing, n) for n in FITTED_TIMING]]))
+    x0 = np.log(np.concatenate([weights.to_array(), [getattr(timing, n) for n in FITTED_TIMING]]))
     upper = np.full(x0.shape, np.inf)
     for i, name in enumerate(FITTED_TIMING):
         if name in _UPPER_LIMITS:
@@ -252,7 +252,9 @@ def run_cmaes(setup, targets, target_loss: float, max_evals: int, seed: int, sig
     (a stop mid-population leaves the rest of that population unevaluated and uncounted), seeded
     as :func:`_cmaes_until` says."""
     max_evals = _check_int("max_evals", max_evals, 1)
-    x0, lower, upper = search_space(start)
+    from footfall.tuning._defaults import creature_defaults
+
+    x0, lower, upper = search_space(creature_defaults(setup.creature), start)
     invalid = 0
 
     def evaluate(x):
@@ -362,6 +364,7 @@ def run_events(creature: str, scenarios, seed: int = 0, max_evals: int = DEFAULT
     preset the tune writes. One untimed evaluation of the defaults warms the planner first."""
     from footfall.planner._weights import ScoringWeights
     from footfall.tuning._config import enable_x64
+    from footfall.tuning._defaults import creature_defaults
     from footfall.tuning._events import event_metrics
     from footfall.tuning._targets import load_tune_targets
     from footfall.tuning._tune_events import EventTuneConfig, checkpoint_path, tune_events
@@ -377,7 +380,8 @@ def run_events(creature: str, scenarios, seed: int = 0, max_evals: int = DEFAULT
     timing = targets.timing()
     say = progress or (lambda message: None)
     say("warming up the exact planner")
-    event_metrics(setup, ScoringWeights(), timing, targets)
+    defaults = creature_defaults(creature)
+    event_metrics(setup, defaults, timing, targets)
     with tempfile.TemporaryDirectory(prefix="footfall-bench-tuning-") as folder:
         out = Path(folder) / f"bench-{creature}.json"
         t0 = time.perf_counter()
@@ -390,7 +394,7 @@ def run_events(creature: str, scenarios, seed: int = 0, max_evals: int = DEFAULT
     proxy = {"wall_s": float(proxy_wall), "exact_evals": 1 + sum(line_search), "exact_loss": target,
              "start_exact_loss": float(state["default_exact"]["exact_loss"]), "rounds_run": len(line_search),
              "accepted_rounds": sum(bool(r["accepted"]) for r in state["history"])}
-    x0 = np.log(ScoringWeights().to_array())
+    x0 = np.log(defaults.to_array())
 
     def evaluate(x):
         try:

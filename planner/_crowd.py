@@ -69,7 +69,7 @@ from footfall.planner._lod import (
 from footfall.planner._maps import WorldRaster
 from footfall.planner._params import PlannerConfig, SearchBudget
 from footfall.planner._timing import stance_lead
-from footfall.planner._weights import ScoringWeights
+from footfall.planner._weights import ScoringWeights, default_weights
 from footfall.planner.layout import CNT_BOXED, CNT_COUPLES_3D, CNT_EXPANDED, LEG_FOOT, N_LEG_COLUMNS
 
 DT = 1.0 / 30.0
@@ -2852,7 +2852,8 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
     seed : int, optional
         Seeds the gait phases and, with ``crowd.heading_mode = "random"``, the headings.
     weights : ScoringWeights, optional
-        Default ``ScoringWeights()``.
+        Default ``default_weights(creature.rest_radius)`` (:func:`planner.default_weights`: the
+        reference scales sized to the creature).
     timing : GaitTiming, optional
         Default ``GaitTiming()``.
     lod_mode : {"off", "on", "zoomed"}, optional
@@ -2911,7 +2912,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         raise ValueError(f"budget: a fixed search budget needs lod_mode 'off', got {lod_mode!r}")
     config = config or planner_config_for(creature)
     controller = controller or ControllerConfig()
-    weights = weights or ScoringWeights()
+    weights = weights or default_weights(creature.rest_radius)
     timing = timing or GaitTiming()
     lod = lod or LodConfig()
     n = int(n_characters or scenario.crowd.count)

@@ -145,6 +145,60 @@ FOOTPRINT_TERMS: tuple[str, ...] = ("distance", "elevation", "slope", "leg_spaci
 TRAJECTORY_TERMS: tuple[str, ...] = ("length", "curvature", "clearance", "climb", "jerk")
 SCORE_TERMS: tuple[str, ...] = FOOTPRINT_TERMS + TRAJECTORY_TERMS
 FOOTPRINT_WEIGHT_FIELDS = tuple("footprint_" + t for t in FOOTPRINT_TERMS)
+METRE_SCALE_FIELDS: tuple[str, ...] = tuple(f.name for f in dataclasses.fields(ScoringWeights)
+                                            if f.metadata["scale"] and f.metadata["unit"] == "m")
+REFERENCE_REST_RADIUS_M = 0.35539095170112855
+"""m: the rest radius of the creature :class:`ScoringWeights`' metre-valued defaults are sized for (the
+built-in spider's, ``scenarios.Creature.rest_radius``)."""
+
+
+def default_weights(rest_radius_m: float) -> ScoringWeights:
+    """The default scoring weights of a creature of rest radius ``rest_radius_m``: the runtime's and
+    the tunes' starting point for it.
+
+    The same goodness laws at every size: each metre-valued reference scale
+    (:data:`METRE_SCALE_FIELDS`: distance, height step, leg spacing, proximity, clearance, climb) is
+    ``ScoringWeights()``'s times ``rest_radius_m / REFERENCE_REST_RADIUS_M``; the weights and the
+    scale-free references (slope, curvature energy, jerk) stay. Why: with the spider's 7 cm clearance
+    a 12 cm beetle's every swing path scored under 1 beside another leg, so the clearance term outvoted
+    the distance to its preferred footprint and 16 % of its strides landed a 3 cm cell off the stride
+    law (docs/locomotion.md).
+
+    Parameters
+    ----------
+    rest_radius_m : float
+        The creature's rest radius (m, ``scenarios.Creature.rest_radius``), > 0.
+
+    Returns
+    -------
+    ScoringWeights
+
+    Raises
+    ------
+    ValueError
+        If ``rest_radius_m`` is not a finite number > 0.
+
+    Examples
+    --------
+    >>> from footfall.planner import REFERENCE_REST_RADIUS_M, ScoringWeights, default_weights
+    >>> default_weights(REFERENCE_REST_RADIUS_M) == ScoringWeights()     # the spider's size: unchanged
+    True
+    >>> half = default_weights(REFERENCE_REST_RADIUS_M / 2)
+    >>> half.clearance_ref_m, half.distance_scale_m, half.slope_critical_rad, half.footprint_distance
+    (0.035, 0.15, 1.0, 3.0)
+    >>> default_weights(0.0)
+    Traceback (most recent call last):
+        ...
+    ValueError: rest_radius_m: expected a finite number > 0, got 0.0
+    """
+    if isinstance(rest_radius_m, bool) or not isinstance(rest_radius_m, (int, float, np.floating, np.integer)) \
+            or not math.isfinite(rest_radius_m) or rest_radius_m <= 0:
+        raise ValueError(f"rest_radius_m: expected a finite number > 0, got {rest_radius_m!r}")
+    k = float(rest_radius_m) / REFERENCE_REST_RADIUS_M
+    defaults = ScoringWeights()
+    return dataclasses.replace(defaults, **{name: getattr(defaults, name) * k for name in METRE_SCALE_FIELDS})
+
+
 TRAJECTORY_WEIGHT_FIELDS = tuple("trajectory_" + t for t in TRAJECTORY_TERMS)
 
 # Index constants into ScoringWeights.to_array(), used by the numba kernels and the JAX proxies.

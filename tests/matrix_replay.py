@@ -13,8 +13,8 @@ import sys
 
 
 def replay(name: str, terrain: str, picks: list[int]) -> dict:
-    from footfall.planner import ScoringWeights, load_preset
-    from footfall.tuning import PRESETS_DIR
+    from footfall.planner import load_preset
+    from footfall.tuning import PRESETS_DIR, creature_defaults
     from footfall.tuning._events import EventSetup, event_metrics
     from footfall.tuning._matrix import CHARACTERS, MATRIX_FILE, PRESETS, TERRAINS, _repo_path
     from footfall.tuning._targets import load_tune_targets
@@ -30,7 +30,7 @@ def replay(name: str, terrain: str, picks: list[int]) -> dict:
         setup = EventSetup(creature, (TERRAINS[terrain],), seeds=(run["seed"],), spawn_fractions=(run["spawn"],),
                            n_characters=CHARACTERS.get(terrain, 1))
         out[k] = {}
-        for side, weights, timing in (("default", ScoringWeights(), targets.timing()),
+        for side, weights, timing in (("default", creature_defaults(creature), targets.timing()),
                                       ("preset", preset.weights, preset.timing or targets.timing())):
             live = event_metrics(setup, weights, timing, targets)["runs"][0]
             out[k][side] = {key: live[key] for key in run[side]}

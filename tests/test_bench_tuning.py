@@ -11,6 +11,7 @@ import pytest
 
 from footfall.benchmarks import tuning_bench as tb
 from footfall import InputError
+from footfall.planner import ScoringWeights
 
 pytestmark = pytest.mark.slow  # tuning benches (about 10 s)
 
@@ -111,13 +112,14 @@ def test_stop_rule(tiny_setup):
     assert first["history"] == never["history"][:1]  # seeded: the same first candidate
 
 
-def test_search_space_starts_at_the_defaults():
+def test_search_space_starts_at_the_creatures_defaults():
     from footfall.planner._timing import GaitTiming
-    from footfall.planner._weights import ScoringWeights
+    from footfall.tuning import creature_defaults
 
-    x0, lower, upper = tb.search_space()
+    ant = creature_defaults("ant")
+    x0, lower, upper = tb.search_space(ant)
     weights, timing = tb.decode(x0)
-    np.testing.assert_allclose(weights.to_array(), ScoringWeights().to_array(), rtol=1e-12)
+    np.testing.assert_allclose(weights.to_array(), ant.to_array(), rtol=1e-12)
     np.testing.assert_allclose(timing.to_array(), GaitTiming().to_array(), rtol=1e-12)
     assert np.all(x0 < upper) and np.all(x0 > lower)
     tb.decode(np.where(np.isfinite(upper), upper, x0))  # the bounds themselves are valid parameters
@@ -132,7 +134,7 @@ def test_both_methods_start_from_the_bench_setups_mis_tuned_timing():
     config = tb.make_config("spider")
     start = config.start()
     assert start == GaitTiming(stride_coefficient=3.0)
-    weights, timing = tb.decode(tb.search_space(start)[0], start)
+    weights, timing = tb.decode(tb.search_space(ScoringWeights(), start)[0], start)
     np.testing.assert_allclose(weights.to_array(), ScoringWeights().to_array(), rtol=1e-12)
     np.testing.assert_allclose(timing.to_array(), start.to_array(), rtol=1e-12)
     with pytest.raises(InputError, match="start_timing"):
@@ -143,7 +145,7 @@ def test_both_methods_start_from_the_bench_setups_mis_tuned_timing():
 
 def test_invalid_candidate_costs_the_penalty(tiny_setup):
     setup, targets = tiny_setup
-    x0, _, upper = tb.search_space()
+    x0, _, upper = tb.search_space(ScoringWeights())
     bad = x0.copy()
     bad[np.isfinite(upper)] = 1.0  # duty_at_rest, stride_exponent = e > their limits
     loss, why = tb.exact_loss_of(setup, targets, bad)

@@ -177,16 +177,13 @@ OFF_PREFERRED_M = 0.005  # a new swing's footprint this far from its preferred o
 OFF_PREFERRED_SHARE = 0.05  # on flat ground at most this share of new swings moves off (spider 2 %, ant 0 %)
 
 
-@pytest.mark.xfail(strict=True, reason="open (session 62): a small creature's footprints leave their preferred spots "
-                   "on flat ground, 16 % of its new swings by 0.5-2.7 cm (a 5.4 cm stride): the scoring's reference "
-                   "scales are absolute metres sized for the spider (clearance_ref_m 7 cm, distance_scale_m 30 cm): "
-                   "scaled by the beetle's rest radius over the spider's (0.345), 16 % -> 0 % (docs/crowds.md, session 62)")
 def test_a_small_creature_alone_on_flat_ground_lands_on_its_preferred_footprints():
     # One creature walking straight on flat ground, nothing near: the preferred footprint (the stride law's)
     # is free, and each new swing should land there. The built-in creatures do (1 x 120 frames, seeds 0-2:
-    # spider 2 % of new swings more than 5 mm off, robot5 2 %, ant and quadruped 0 %); the beetle, a
-    # creature no session had tuned for, 16 %: its strides snap to its 3 cm cells (per-stride p90 0.12 on
-    # flat ground alone, 0.21 with a neighbour, 0.38 on hills).
+    # spider 2 % of new swings more than 5 mm off, robot5 2 %, ant and quadruped 0 %). The beetle, a
+    # creature no session had tuned for, did not while the scoring's reference scales were the spider's
+    # metres (16 %: its strides snapped to its 3 cm cells, the 7 cm clearance scale outvoting the distance
+    # to the preferred footprint); with them sized to the creature (planner.default_weights) it does.
     import footfall.planner._crowd as crowd
     from footfall.planner import layout
     from footfall.scenarios import load_scenario

@@ -86,7 +86,7 @@ def _every_preset():
 
 @pytest.mark.parametrize("name", _every_preset())
 def test_a_shipped_preset_differs_from_the_defaults_and_records_its_tune(name):
-    from footfall.planner import ScoringWeights
+    from footfall.tuning import creature_defaults
     from footfall.tuning._matrix import PRESETS
 
     path = PRESETS_DIR / f"{name}.json"
@@ -95,7 +95,7 @@ def test_a_shipped_preset_differs_from_the_defaults_and_records_its_tune(name):
     spec = PRESETS[name]
     preset = load_preset(path, spec["creature"])
     w = preset.weights.to_array()
-    w0 = ScoringWeights().to_array()
+    w0 = creature_defaults(spec["creature"]).to_array()
     assert np.max(np.abs(w / w0 - 1.0)) >= MIN_WEIGHT_CHANGE
     summary = preset.provenance["summary"]
     for key in ("scenarios", "targets", "heldout_loss_default", "heldout_loss_tuned", "heldout_gain_se",

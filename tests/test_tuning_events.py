@@ -413,10 +413,10 @@ def test_the_offset_block_is_off_only_for_a_style_with_a_clearance_bound():
 
 
 def test_the_events_checkpoint_round_trips_and_names_a_broken_field(tmp_path):
-    from footfall.tuning._tune import BestSoFar, _default_params
+    from footfall.tuning._tune import BestSoFar, TuneConfig, _default_params
     from footfall.tuning._tune_events import EventTuneCheckpoint
 
-    params = _default_params()
+    params = _default_params(TuneConfig("spider"))
     metrics = {"exact_loss": 0.5, "stride_rel_error": math.nan, "collisions": 0, "finite": True,
                "means": {"stride_error": None}, "runs": [{"run_loss": 0.5, "stride_error": math.nan}]}
     state = EventTuneCheckpoint(config={"creature": "spider"}, round=1, stopped=True, current=params,

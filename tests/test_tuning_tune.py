@@ -190,12 +190,13 @@ def test_shipped_presets_meet_the_stride_target_on_held_out_runs_without_collisi
 def test_a_shipped_preset_is_the_defaults_exactly_when_its_tune_accepted_no_candidate(creature):
     """best_round -1 (no candidate accepted) <=> the defaults bit for bit <=> the held-out numbers of
     the defaults (the runs are deterministic); a tuned preset must not lose on the held-out runs."""
-    from footfall.planner import GaitTiming, ScoringWeights
+    from footfall.planner import GaitTiming
+    from footfall.tuning import creature_defaults
 
     preset = load_preset(PRESETS / f"{creature}.json", creature)
     kept = preset.provenance["summary"]["best_round"] == -1
     losses = preset.provenance["losses"]
-    assert kept == (preset.weights == ScoringWeights() and preset.timing == GaitTiming())
+    assert kept == (preset.weights == creature_defaults(creature) and preset.timing == GaitTiming())
     assert kept == (losses["heldout_tuned"] == losses["heldout_default"])
     assert losses["heldout_tuned"]["stride_rel_error"] <= losses["heldout_default"]["stride_rel_error"]
 
@@ -316,7 +317,7 @@ def test_guards_allow_the_higher_of_the_defaults_and_a_mis_tuned_start():
 def test_a_checkpoint_round_trips_through_json_and_names_a_broken_field(tmp_path):
     from footfall.tuning._tune import BestSoFar, TuneCheckpoint, _default_params
 
-    params = _default_params()
+    params = _default_params(_tiny())
     exact = _metrics([1.0, 2.0], 1.5)
     state = TuneCheckpoint(config={"creature": "spider"}, round=1, stopped=False, current=params, current_exact=exact,
                            best=BestSoFar(params, exact, 0), start_exact=exact, default_exact=None,

@@ -23,6 +23,23 @@ def test_field_order_is_the_array_order_and_documented():
     assert w.to_array()[WEIGHT_FIELDS.index("slope_critical_rad")] == w.slope_critical_rad
 
 
+def test_default_weights_size_the_metre_scales_to_the_creature():
+    """A creature of twice the spider's rest radius: every metre-valued scale doubles, by hand; the
+    weights and the scale-free references stay; the spider's size gives ScoringWeights() exactly."""
+    from footfall.planner import METRE_SCALE_FIELDS, REFERENCE_REST_RADIUS_M, default_weights
+    from footfall.scenarios import load_creature
+
+    assert METRE_SCALE_FIELDS == ("distance_scale_m", "step_critical_m", "leg_spacing_ref_m", "proximity_ref_m",
+                                  "clearance_ref_m", "climb_ref_m")
+    twice = default_weights(2 * REFERENCE_REST_RADIUS_M)
+    np.testing.assert_array_equal(twice.to_array(), [3.0, 1.0, 1.0, 1.0, 1.0, 2.0, 1.0, 0.5, 1.0, 0.5,
+                                                     0.60, 0.24, 1.0, 0.10, 0.20, 1.0, 0.14, 0.20, 2000.0])
+    assert default_weights(load_creature("spider").rest_radius) == ScoringWeights()
+    for bad in (0.0, -0.1, float("nan"), float("inf"), "0.3", True):
+        with pytest.raises(ValueError, match="rest_radius_m"):
+            default_weights(bad)
+
+
 def test_weights_are_frozen():
     with pytest.raises(dataclasses.FrozenInstanceError):
         ScoringWeights().footprint_distance = 2.0

@@ -57,6 +57,7 @@ def shipped_preset_paths() -> list[Path]:
 # presets without it. A name is imported from its module on first use.
 _EXPORTS = {
     "enable_x64": "_config",
+    "creature_defaults": "_defaults",
     **dict.fromkeys(("FITTED_TIMING", "FitProblem", "fit", "loss", "make_problem", "residuals"), "_fit"),
     **dict.fromkeys(("PROXY_METRICS", "Situations", "couple_scores", "duty_factor", "expected_metrics",
                      "hard_metrics", "preferred_footprint", "preferred_lead_time", "situations_from_harvest",

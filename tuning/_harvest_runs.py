@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from footfall.planner import (GaitTiming, Harvest, ScoringWeights, harvest_run, merge_harvest_chunks, pack_harvest,
                               task_mapper)
+from footfall.tuning._defaults import creature_defaults
 
 
 def harvest_situations(scenarios=("mixed",), creatures=("spider",), *, seeds=(0,), frames: int = 30,
@@ -39,7 +40,9 @@ def harvest_situations(scenarios=("mixed",), creatures=("spider",), *, seeds=(0,
     n_characters : int, optional
         Characters of each crowd, >= 1 (default 2).
     weights : ScoringWeights, optional
-        The scoring weights of the runs (default ``ScoringWeights()``).
+        The scoring weights of the runs. Default: with one creature, its defaults
+        (:func:`tuning.creature_defaults`, as the runtime gives it); with several, who share one
+        weights vector, ``ScoringWeights()``.
     timing : GaitTiming, optional
         The gait timing of the runs (default ``GaitTiming()``).
     max_situations : int, optional
@@ -88,7 +91,8 @@ def harvest_situations(scenarios=("mixed",), creatures=("spider",), *, seeds=(0,
                                        or max_situations < 1):
         raise ValueError(f"max_situations: expected None or an integer >= 1, got {max_situations!r}")
     run = task_mapper(map_tasks)
-    weights = weights or ScoringWeights()
+    if weights is None:
+        weights = creature_defaults(creatures[0]) if len(creatures) == 1 else ScoringWeights()
     timing = timing or GaitTiming()
     tasks = harvest_tasks(scenarios, creatures, seeds, frames, n_characters, weights, timing, max_situations)
     # In this process the chunks run lazily: once the cap is reached the rest never run. With a

@@ -69,8 +69,10 @@ PRESETS = {
     "quadruped-stairs": {"creature": "quadruped", "terrain": "stairs",
                          "command": "footfall tune --creature quadruped --scenarios stairs,crates --spearman-candidates 20 "
                                     "--out tuning/data/presets/quadruped-stairs.json"},
+    # Nine seeds: from the defaults sized to the ant (session 63), on three its first step gained 0.0081
+    # against 2 x SE 0.0086 and the tune kept the defaults.
     "ant-stairs": {"creature": "ant", "terrain": "stairs",
-                   "command": "footfall tune --creature ant --scenarios stairs --spearman-candidates 20 "
+                   "command": "footfall tune --creature ant --scenarios stairs --seeds 9 --spearman-candidates 20 "
                               "--out tuning/data/presets/ant-stairs.json"},
     "ant-crates": {"creature": "ant", "terrain": "crates",
                    "command": "footfall tune --creature ant --scenarios crates --out tuning/data/presets/ant-crates.json"},
@@ -194,7 +196,8 @@ def run_matrix(presets_dir: str | Path, names=None, runs: int = RUNS, terrains=N
                progress=None) -> dict:
     """Every preset of ``names`` (default: :data:`PRESETS`) found in ``presets_dir`` (``NAME.json``)
     against the defaults on ``terrains`` (default: :data:`TERRAINS`); the matrix (JSON-ready)."""
-    from footfall.planner import ScoringWeights, load_preset
+    from footfall.planner import load_preset
+    from footfall.tuning._defaults import creature_defaults
     from footfall.tuning._targets import load_tune_targets
 
     names = tuple(names or PRESETS)
@@ -212,7 +215,8 @@ def run_matrix(presets_dir: str | Path, names=None, runs: int = RUNS, terrains=N
             continue
         creature = spec["creature"]
         preset = load_preset(path, creature)
-        if preset.weights == ScoringWeights() and (preset.timing is None or preset.timing == load_tune_targets(
+        own_defaults = creature_defaults(creature)
+        if preset.weights == own_defaults and (preset.timing is None or preset.timing == load_tune_targets(
                 _repo_path(spec["style"]) if "style" in spec else None, creature).timing()):
             # Its tune accepted no candidate: the defaults against themselves would prove nothing.
             rounds = preset.provenance.get("rounds", [])
@@ -233,11 +237,11 @@ def run_matrix(presets_dir: str | Path, names=None, runs: int = RUNS, terrains=N
             key = (creature, terrain, spec.get("style"))
             if key not in defaults:
                 say(f"{creature} defaults on {terrain}")
-                defaults[key] = event_metrics(setup, ScoringWeights(), targets.timing(), targets, map_tasks)
+                defaults[key] = event_metrics(setup, own_defaults, targets.timing(), targets, map_tasks)
             say(f"{name} on {terrain}")
             mine = event_metrics(setup, preset.weights, preset.timing or targets.timing(), targets, map_tasks)
             cells[terrain] = dict(evaluate_cell(defaults[key], mine, style), runs=cell_runs(defaults[key], mine, style))
-        w0 = ScoringWeights().to_array()
+        w0 = own_defaults.to_array()
         w = preset.weights.to_array()
         change = float(np.max(np.abs(w / w0 - 1.0)))
         passes, why = verdict(name, cells, style, change)

@@ -253,17 +253,18 @@ def _params(weights, timing) -> dict:
 
 
 def _start_params(config: TuneConfig) -> dict:
-    """The default weights and ``config.start()``'s timing: where the search begins."""
-    from footfall.planner import ScoringWeights
+    """The creature's default weights and ``config.start()``'s timing: where the search begins."""
+    from footfall.tuning._defaults import creature_defaults
 
-    return _params(ScoringWeights().to_array(), config.start().to_array())
+    return _params(creature_defaults(config.creature).to_array(), config.start().to_array())
 
 
-def _default_params() -> dict:
-    """The runtime's defaults (the start when ``start_timing`` is empty)."""
-    from footfall.planner import GaitTiming, ScoringWeights
+def _default_params(config: TuneConfig) -> dict:
+    """The runtime's defaults for the creature (the start when ``start_timing`` is empty)."""
+    from footfall.planner import GaitTiming
+    from footfall.tuning._defaults import creature_defaults
 
-    return _params(ScoringWeights().to_array(), GaitTiming().to_array())
+    return _params(creature_defaults(config.creature).to_array(), GaitTiming().to_array())
 
 
 def _objects(params: dict):
@@ -676,7 +677,7 @@ def _tune(config: TuneConfig, out, resume, progress, stop_after, write, evaluate
         default_exact = None if config.start_timing else start_exact  # None: not measured (yet)
         if config.start_timing and config.guards:
             say("exact loss of the default weights (the guards' reference)", 0, total)
-            default_exact = exact_metrics(setup, *_objects(_default_params()), targets=targets, map_tasks=map_tasks)
+            default_exact = exact_metrics(setup, *_objects(_default_params(config)), targets=targets, map_tasks=map_tasks)
         state = TuneCheckpoint(config=config.to_json(), round=0, stopped=False, current=start_params,
                                current_exact=start_exact, best=BestSoFar(start_params, start_exact, -1),
                                start_exact=start_exact, default_exact=default_exact, history=())
@@ -720,8 +721,8 @@ def _tune(config: TuneConfig, out, resume, progress, stop_after, write, evaluate
     if config.start_timing:
         # A mis-tuned start: "default" still means the runtime's defaults, measured here too.
         if default_exact is None:  # guards off: not measured during the search
-            default_exact = exact_metrics(setup, *_objects(_default_params()), targets=targets, map_tasks=map_tasks)
-        held_default = exact_metrics(holdout, *_objects(_default_params()), targets=targets, map_tasks=map_tasks)
+            default_exact = exact_metrics(setup, *_objects(_default_params(config)), targets=targets, map_tasks=map_tasks)
+        held_default = exact_metrics(holdout, *_objects(_default_params(config)), targets=targets, map_tasks=map_tasks)
     held_tuned = exact_metrics(holdout, *_objects(best.params), targets=targets, map_tasks=map_tasks)
     refused = None
     worse = []
@@ -765,7 +766,7 @@ def _tune(config: TuneConfig, out, resume, progress, stop_after, write, evaluate
         "heldout_loss_default": held_default.exact_loss, "heldout_loss_tuned": held_tuned.exact_loss,
         "heldout_gain_se": _gain_in_se(held_default, held_tuned),
         "weights_max_rel_change": float(np.max(np.abs(np.asarray(best.params["weights"])
-                                                      / np.asarray(_default_params()["weights"]) - 1.0))),
+                                                      / np.asarray(_default_params(config)["weights"]) - 1.0))),
         "spearman_metric_change": None,
     }
     if config.start_timing:

@@ -156,10 +156,12 @@ def check_scenarios(text: str) -> tuple[str, ...]:
     return names
 
 
-def _start(targets) -> dict:
-    from footfall.planner import ScoringWeights
+def _start(config, targets) -> dict:
+    """The creature's default weights and the targets' stride law: where the tune begins."""
+    from footfall.tuning._defaults import creature_defaults
 
-    return {"weights": _floats(ScoringWeights().to_array()), "timing": _floats(targets.timing().to_array())}
+    return {"weights": _floats(creature_defaults(config.creature).to_array()),
+            "timing": _floats(targets.timing().to_array())}
 
 
 def style_start(params: dict, targets) -> dict:
@@ -327,7 +329,7 @@ def _run(config, out, resume, progress, stop_after, write, map_tasks, t0, spearm
     ckpt = checkpoint_path(out)
     say = progress or (lambda *a: None)
     total = config.rounds + 2
-    start = _start(targets)
+    start = _start(config, targets)
     if resume:
         state = _load(ckpt, config)
         say(f"resumed at round {state.round}", state.round + 1, total)

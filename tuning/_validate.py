@@ -38,13 +38,13 @@ UNMOVED = {"curvature_p95": 1e-9}
 1e-27 (rounding), and ranking rounding noise says nothing about the proxies."""
 
 
-def candidate_weights(n: int, seed: int) -> list[np.ndarray]:
-    """``n`` weight vectors (ScoringWeights.to_array()) around the defaults (module docstring)."""
-    from footfall.planner import ScoringWeights
+def candidate_weights(n: int, seed: int, base: np.ndarray) -> list[np.ndarray]:
+    """``n`` weight vectors (ScoringWeights.to_array()) around ``base``, the creature's defaults
+    (module docstring)."""
     from footfall.planner.layout import N_TERMS
 
     rng = np.random.default_rng(seed)
-    base = ScoringWeights().to_array()
+    base = np.asarray(base, dtype=np.float64)
     out = []
     for _ in range(n):
         w = base.copy()
@@ -59,8 +59,9 @@ def metric_change_spearman(config, targets, n: int, map_tasks=None) -> dict:
     from scipy.stats import spearmanr
 
     from footfall.planner import ScoringWeights
-    from footfall.tuning._harvest_runs import harvest_situations
     from footfall.tuning._config import enable_x64
+    from footfall.tuning._defaults import creature_defaults
+    from footfall.tuning._harvest_runs import harvest_situations
     from footfall.tuning._events import CLEARANCE_CAP_H, event_metrics, spawn_variant
     from footfall.tuning._proxies import compiled_expected_metrics, situations_from_harvest
     from footfall.tuning._tune_events import HARVEST_SPAWN
@@ -83,12 +84,13 @@ def metric_change_spearman(config, targets, n: int, map_tasks=None) -> dict:
         return {k: float(jnp.mean(m[k])) for k, _, _ in PAIRS}
 
     setup = config.setup()
-    default_w = ScoringWeights().to_array()
+    defaults = creature_defaults(config.creature)
+    default_w = defaults.to_array()
     p0 = proxy(default_w)
-    e0 = event_metrics(setup, ScoringWeights(), timing, targets, map_tasks)
+    e0 = event_metrics(setup, defaults, timing, targets, map_tasks)
     predicted = {k: [] for k, _, _ in PAIRS}
     measured = {k: [] for _, k, _ in PAIRS}
-    candidates = candidate_weights(n, config.seed + 2000)
+    candidates = candidate_weights(n, config.seed + 2000, default_w)
     for w in candidates:
         p = proxy(w)
         e = event_metrics(setup, ScoringWeights.from_array(w), timing, targets, map_tasks)

@@ -1,0 +1,32 @@
+"""A creature's default scoring weights, where tuning starts and what its presets are measured against."""
+
+from __future__ import annotations
+
+
+def creature_defaults(creature: str):
+    """The runtime's default :class:`planner.ScoringWeights` for ``creature`` (a built-in name or a
+    creature file): :func:`planner.default_weights` at its rest radius, the weights ``init_crowd``
+    gives it when none are passed.
+
+    Parameters
+    ----------
+    creature : str
+        A built-in creature's name or a creature file (``scenarios.load_creature``).
+
+    Returns
+    -------
+    footfall.planner.ScoringWeights
+
+    Examples
+    --------
+    >>> from footfall.planner import ScoringWeights
+    >>> from footfall.tuning import creature_defaults
+    >>> creature_defaults("spider") == ScoringWeights()          # the size the defaults are written for
+    True
+    >>> round(creature_defaults("ant").clearance_ref_m, 4)        # 0.47 x the spider's 7 cm: the ant's size
+    0.033
+    """
+    from footfall.planner import default_weights
+    from footfall.scenarios import load_creature
+
+    return default_weights(load_creature(creature).rest_radius)
