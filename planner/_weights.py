@@ -156,13 +156,17 @@ def default_weights(rest_radius_m: float) -> ScoringWeights:
     """The default scoring weights of a creature of rest radius ``rest_radius_m``: the runtime's and
     the tunes' starting point for it.
 
-    The same goodness laws at every size: each metre-valued reference scale
-    (:data:`METRE_SCALE_FIELDS`: distance, height step, leg spacing, proximity, clearance, climb) is
-    ``ScoringWeights()``'s times ``rest_radius_m / REFERENCE_REST_RADIUS_M``; the weights and the
-    scale-free references (slope, curvature energy, jerk) stay. Why: with the spider's 7 cm clearance
-    a 12 cm beetle's every swing path scored under 1 beside another leg, so the clearance term outvoted
-    the distance to its preferred footprint and 16 % of its strides landed a 3 cm cell off the stride
-    law (docs/locomotion.md).
+    The same goodness laws at every size up to the spider's: for a smaller creature each metre-valued
+    reference scale (:data:`METRE_SCALE_FIELDS`: distance, height step, leg spacing, proximity,
+    clearance, climb) is ``ScoringWeights()``'s times ``rest_radius_m / REFERENCE_REST_RADIUS_M``; the
+    weights and the scale-free references (slope, curvature energy, jerk) stay. Why: with the spider's
+    7 cm clearance a 12 cm beetle's every swing path scored as near another leg's room, the clearance
+    term outvoted the distance to its preferred footprint, and 16 % of its strides landed a 3 cm cell
+    off the stride law (0 % sized to it; docs/locomotion.md). A larger creature keeps the spider's
+    scales, as its planner keeps the spider's 7 cm cells and 0.25 m search radius
+    (``planner_config_for``): grown with it, a crab of 1.6 times the spider's size walked further off
+    the stride law among crates and other crabs (per-stride p90 0.257 -> 0.287 on ``mixed``, 30 runs),
+    while robot5 (1.2 times) was within the noise.
 
     Parameters
     ----------
@@ -186,6 +190,8 @@ def default_weights(rest_radius_m: float) -> ScoringWeights:
     >>> half = default_weights(REFERENCE_REST_RADIUS_M / 2)
     >>> half.clearance_ref_m, half.distance_scale_m, half.slope_critical_rad, half.footprint_distance
     (0.035, 0.15, 1.0, 3.0)
+    >>> default_weights(2 * REFERENCE_REST_RADIUS_M) == ScoringWeights()  # larger: the spider's scales
+    True
     >>> default_weights(0.0)
     Traceback (most recent call last):
         ...
@@ -194,8 +200,10 @@ def default_weights(rest_radius_m: float) -> ScoringWeights:
     if isinstance(rest_radius_m, bool) or not isinstance(rest_radius_m, (int, float, np.floating, np.integer)) \
             or not math.isfinite(rest_radius_m) or rest_radius_m <= 0:
         raise ValueError(f"rest_radius_m: expected a finite number > 0, got {rest_radius_m!r}")
-    k = float(rest_radius_m) / REFERENCE_REST_RADIUS_M
+    k = min(1.0, float(rest_radius_m) / REFERENCE_REST_RADIUS_M)
     defaults = ScoringWeights()
+    if k == 1.0:
+        return defaults
     return dataclasses.replace(defaults, **{name: getattr(defaults, name) * k for name in METRE_SCALE_FIELDS})
 
 

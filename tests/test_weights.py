@@ -23,18 +23,21 @@ def test_field_order_is_the_array_order_and_documented():
     assert w.to_array()[WEIGHT_FIELDS.index("slope_critical_rad")] == w.slope_critical_rad
 
 
-def test_default_weights_size_the_metre_scales_to_the_creature():
-    """A creature of twice the spider's rest radius: every metre-valued scale doubles, by hand; the
-    weights and the scale-free references stay; the spider's size gives ScoringWeights() exactly."""
+def test_default_weights_size_the_metre_scales_to_a_smaller_creature():
+    """A creature of half the spider's rest radius: every metre-valued scale halves, by hand; the
+    weights and the scale-free references stay. The spider's size, or a larger one (whose planner keeps
+    the spider's 7 cm cells), gives ScoringWeights() exactly."""
     from footfall.planner import METRE_SCALE_FIELDS, REFERENCE_REST_RADIUS_M, default_weights
     from footfall.scenarios import load_creature
 
     assert METRE_SCALE_FIELDS == ("distance_scale_m", "step_critical_m", "leg_spacing_ref_m", "proximity_ref_m",
                                   "clearance_ref_m", "climb_ref_m")
-    twice = default_weights(2 * REFERENCE_REST_RADIUS_M)
-    np.testing.assert_array_equal(twice.to_array(), [3.0, 1.0, 1.0, 1.0, 1.0, 2.0, 1.0, 0.5, 1.0, 0.5,
-                                                     0.60, 0.24, 1.0, 0.10, 0.20, 1.0, 0.14, 0.20, 2000.0])
+    half = default_weights(0.5 * REFERENCE_REST_RADIUS_M)
+    np.testing.assert_array_equal(half.to_array(), [3.0, 1.0, 1.0, 1.0, 1.0, 2.0, 1.0, 0.5, 1.0, 0.5,
+                                                    0.15, 0.06, 1.0, 0.025, 0.05, 1.0, 0.035, 0.05, 2000.0])
     assert default_weights(load_creature("spider").rest_radius) == ScoringWeights()
+    assert default_weights(2 * REFERENCE_REST_RADIUS_M) == ScoringWeights()
+    assert default_weights(load_creature("robot5").rest_radius) == ScoringWeights()  # 1.2 x the spider's
     for bad in (0.0, -0.1, float("nan"), float("inf"), "0.3", True):
         with pytest.raises(ValueError, match="rest_radius_m"):
             default_weights(bad)
