@@ -181,7 +181,8 @@ def check_cmd(
         g, _, _ = resolve_gait(None, c, "default")
         where = file
         line = (f"{file}: ok: creature {c.name}, {c.n_legs} legs x {c.n_segments} segments, reach "
-                f"{c.max_reach:.3g} m; default gait {g.name}: {g.description}")
+                f"{c.max_reach:.3g} m, rest radius {c.rest_radius:.3g} m ({scoring_scales_note(c.rest_radius)}); "
+                f"default gait {g.name}: {g.description}")
     else:
         if creature is None:
             raise InputError("argument", "--creature", f"a gait is checked against a creature: footfall check {file} "
@@ -849,6 +850,17 @@ def matrix_table(matrix: dict) -> Table:
             row.append(text)
         table.add_row(name, *row, "yes" if p["passes"] else "no: " + p["why"][0][:120])
     return table
+
+
+def scoring_scales_note(rest_radius: float) -> str:
+    """How the default scoring weights' metre scales fit a creature of ``rest_radius`` (m)
+    (``planner.default_weights``): what ``footfall check`` says of a creature file."""
+    from footfall.planner import REFERENCE_REST_RADIUS_M
+
+    k = rest_radius / REFERENCE_REST_RADIUS_M
+    if k < 1.0:
+        return f"the scoring's metre scales x{k:.2f} of the spider's"
+    return "the scoring's metre scales the spider's"
 
 
 @bench_app.command("planner")

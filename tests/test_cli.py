@@ -14,6 +14,18 @@ def run(*args, cwd=None):
     return subprocess.run(CLI + list(args), capture_output=True, text=True, cwd=cwd, timeout=600)
 
 
+def test_check_says_how_the_scoring_scales_fit_a_creature():
+    # The beetle's rest radius is 0.345 of the spider's: its default weights' metre scales are scaled so.
+    from pathlib import Path
+
+    beetle = Path(__file__).parent / "data" / "creatures" / "beetle.toml"
+    done = footfall_cli("check", str(beetle))
+    assert done.returncode == 0, done.stderr
+    assert "rest radius 0.123 m (the scoring's metre scales x0.35 of the spider's)" in done.stdout
+    done = footfall_cli("check", "spider")
+    assert done.returncode == 0 and "(the scoring's metre scales the spider's)" in done.stdout, done.stdout
+
+
 @pytest.mark.parametrize(
     "content, field",
     [
