@@ -85,3 +85,26 @@ def test_budget_and_config_validation():
     with pytest.raises(ValueError, match="map_cells"):
         PlannerConfig(map_cells=1)
     assert SearchBudget(None, None, False).kernel_args() == (-1, -1.0, False)
+
+
+@pytest.mark.parametrize("creature", ["ant", "quadruped", "robot5", "spider"])
+def test_one_definition_of_a_creatures_default_weights(creature):
+    """The runtime's default (init_crowd without weights), the tunes' starts and the tuning's
+    creature_defaults are one set of numbers for each creature."""
+    from footfall.planner import default_weights, init_crowd
+    from footfall.scenarios import load_creature, load_scenario
+    from footfall.scenarios._gait_choice import resolve_gait
+    from footfall.tuning import creature_defaults
+    from footfall.tuning._targets import load_tune_targets
+    from footfall.tuning._tune import TuneConfig, _default_params, _start_params
+    from footfall.tuning._tune_events import EventTuneConfig, _start
+
+    c = load_creature(creature)
+    gait, _, _ = resolve_gait(None, c)
+    model, _ = init_crowd(load_scenario("flat"), c, gait, n_characters=1, seed=0)
+    expected = default_weights(c.rest_radius)
+    assert model.weights == expected == creature_defaults(creature)
+    for params in (_start_params(TuneConfig(creature)), _default_params(TuneConfig(creature)),
+                   _start(EventTuneConfig(creature), load_tune_targets(None, creature))):
+        np.testing.assert_array_equal(params["weights"], expected.to_array())
+    assert (expected == ScoringWeights()) == (creature in ("spider", "robot5"))  # not smaller than the spider
