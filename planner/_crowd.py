@@ -2947,13 +2947,15 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         raise ValueError(f"raster: cell size {raster.frame.cell_size} differs from the planner's {config.cell_size}")
     from footfall.planner._gait_schedule import as_schedule
     from footfall.planner._timing import GRAVITY, hip_height
-    from footfall.planner._workspace import height_ranges, speed_cap, stance_windows, tuck_reaches
+    from footfall.planner._workspace import frame_rate_cap, height_ranges, speed_cap, stance_windows, tuck_reaches
 
     schedule = as_schedule(gait)
     window = stance_windows(creature, rest_body, hips_body, leg_static)
-    # Past this speed even the least duty factor's stance sweep does not fit the legs' windows:
-    # the controller caps the speed there (reported as speed_cap; the CLI says so).
-    cap = speed_cap(timing, hip_height(creature), float(np.min(window[:, 1] - window[:, 0])))
+    # Past this speed even the least duty factor's stance sweep does not fit the legs' windows, or a
+    # stride cycle lasts under MIN_CYCLE_FRAMES frames (a tiny creature): the controller caps the
+    # speed there (reported as speed_cap; the CLI says so).
+    cap = min(speed_cap(timing, hip_height(creature), float(np.min(window[:, 1] - window[:, 0]))),
+              frame_rate_cap(timing, hip_height(creature), DT))
     speed = min(speed_asked, cap)
     escape = min(cap, math.sqrt(ESCAPE_FROUDE * GRAVITY * hip_height(creature)))
     far_first, far_fallback = None, None

@@ -416,9 +416,9 @@ def render(scene_path, out_dir, regions_path=None, size: tuple[int, int] = WINDO
     # The framings use the feet and the pelvis only (the legs lie between them): a picture
     # without the creatures is framed the same way.
     everything = np.concatenate([scene["feet"].reshape(-1, 3), scene["pelvis"].reshape(-1, 3)])
-    overview = framing(everything, aspect, min_radius=1.0)
+    overview = framing(everything, aspect, min_radius=min(1.0, 8.0 * reach))
     own = np.concatenate([scene["feet"][last, 0], scene["pelvis"][last, :1]])
-    closeup = framing(own, aspect, min_radius=max(0.3, 2.5 * reach))
+    closeup = framing(own, aspect, min_radius=max(min(0.3, 8.0 * reach), 2.5 * reach))
     written, regions = [], {}
     view = SceneView(pv, scene, size)
     try:
@@ -451,7 +451,9 @@ def camera_path(scene: dict, camera: str, aspect: float) -> tuple[np.ndarray, np
 
     frames = int(scene["pelvis"].shape[0])
     reach = _creature_extent(scene)
-    min_radius = max(0.4, 3.0 * reach)
+    # At least three of the creature's own sizes; the 0.4 m floor holds only for creatures that large
+    # (a 4 cm mite's crowd filled a tenth of the picture).
+    min_radius = max(min(0.4, 4.0 * reach), 3.0 * reach)
     poses = scene["joints"].reshape(frames, -1, 3) if "joints" in scene else scene["feet"].reshape(frames, -1, 3)
     poses = np.concatenate([poses, scene["pelvis"]], axis=1)
     if camera == "fixed":

@@ -30,9 +30,12 @@ def say_speed_cap(model) -> None:
     """One note on stderr when the creature's legs cannot carry the asked speed (the controller caps it)."""
     import sys
 
+    from footfall.planner._workspace import MIN_CYCLE_FRAMES
+
     if model.speed_asked > model.speed_cap:
         print(f"footfall: note: {model.creature.name}: {model.speed_asked:g} m/s asked; speed capped at "
-              f"{model.speed_cap:.3g} m/s, the fastest its legs carry at the stride law", file=sys.stderr)
+              f"{model.speed_cap:.3g} m/s, the fastest its legs carry at the stride law in stride cycles of at "
+              f"least {MIN_CYCLE_FRAMES} frames", file=sys.stderr)
 
 
 def recording_meta(scenario, seed: int, lod: str, gait, navigate: bool = True) -> dict:

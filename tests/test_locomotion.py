@@ -205,3 +205,27 @@ def test_a_small_creature_alone_on_flat_ground_lands_on_its_preferred_footprints
     assert off.size > 100, "the premise: the beetle walks and steps"
     share = float((off > OFF_PREFERRED_M).mean())
     assert share <= OFF_PREFERRED_SHARE, f"{share:.0%} of {off.size} new swings land over 5 mm off; largest {off.max():.4f} m"
+
+
+MITE = Path(__file__).parent / "data" / "creatures" / "mite.toml"
+
+
+def test_a_tiny_creature_is_capped_to_a_gait_the_frames_can_draw(monkeypatch):
+    # A 3 cm mite asked the scenarios' 0.3 m/s would step at 11.8 Hz, a stride cycle of 2.5 frames: its
+    # swings last under a frame and its legs are drawn across each other (six mites, 300 frames on flat:
+    # 65 crossing frames over seeds 13000-13004). Capped where a cycle lasts 4 frames (0.097 m/s): none.
+    import footfall.planner._workspace as workspace
+    from footfall.planner import GaitTiming, hip_height, stride_frequency
+    from footfall.planner._crowd import DT, init_crowd
+    from footfall.planner._simulation import simulate
+    from footfall.scenarios import load_scenario
+    from footfall.scenarios._gait_choice import resolve_gait
+
+    mite = load_creature(str(MITE))
+    gait, _, _ = resolve_gait(None, mite)
+    model, state = init_crowd(load_scenario("flat"), mite, gait, n_characters=6, seed=1)
+    f = stride_frequency(GaitTiming(), model.speed_cap, hip_height(mite))
+    assert model.speed_cap < 0.3 and f * DT * workspace.MIN_CYCLE_FRAMES == pytest.approx(1.0)
+    summary = simulate(model, state, 150)
+    assert summary.leg_crossings == 0 and summary.speed_reached > 0.9 * model.speed_cap
+    assert summary.stride_rel_error_p90 < 0.25
