@@ -2795,15 +2795,24 @@ def set_feet_spacing(state: CrowdState, characters, scale) -> None:
     state.feet_spacing[characters] = scale
 
 
+def planning_span(creature, config: PlannerConfig) -> float:
+    """How far (m) from its centre a creature's feet plan: its rest radius, the candidate disc and
+    its longest leg's reach (what its local maps must hold, with a margin: ``init_crowd``)."""
+    return float(creature.rest_radius) + config.search_radius_m + float(np.max(creature.leg_reach))
+
+
 def planner_config_for(creature) -> PlannerConfig:
     """The paper's 70 x 70 maps of 7 cm cells, with finer cells (and a smaller candidate disc)
-    for creatures too small for 7 cm: about four cells from the body centre to a rest foot.
+    for creatures too small for 7 cm: about four cells from the body centre to a rest foot; and
+    more cells for a creature too large for 70 (its feet plan further than the maps reach).
 
     Parameters
     ----------
     creature : scenarios.Creature
         Its ``rest_radius`` (m) sets the cell size: a quarter of it rounded to 5 mm, between
-        1 and 7 cm; the candidate disc's radius is 0.75 rest radii, at most 25 cm.
+        1 and 7 cm; the candidate disc's radius is 0.75 rest radii, at most 25 cm. Its
+        :func:`planning_span` sets the cells per side: 70, or as many as hold it (a creature of
+        0.82 m rest radius and 0.89 m legs: 74; the planning cost grows with their square).
 
     Returns
     -------
@@ -2819,9 +2828,13 @@ def planner_config_for(creature) -> PlannerConfig:
     >>> ant.map_cells, ant.cell_size, round(ant.search_radius_m, 3)
     (70, 0.04, 0.125)
     """
+    from footfall.planner._far_planning import map_cells_holding
+
     rest = float(creature.rest_radius)
     cell = min(0.07, max(0.01, round(rest / 4.0 / 0.005) * 0.005))
-    return PlannerConfig(cell_size=cell, search_radius_m=min(0.25, 0.75 * rest))
+    config = PlannerConfig(cell_size=cell, search_radius_m=min(0.25, 0.75 * rest))
+    cells = map_cells_holding(config, planning_span(creature, config))
+    return config if cells <= config.map_cells else dataclasses.replace(config, map_cells=cells)
 
 
 def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, seed: int = 0,
@@ -2921,7 +2934,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
     if creature.n_legs < 1:
         raise InputError(creature.name, "legs", "a creature needs at least one leg")
     map_half = 0.5 * config.map_cells * config.cell_size
-    span = float(creature.rest_radius) + config.search_radius_m + float(np.max(creature.leg_reach))
+    span = planning_span(creature, config)
     if span + (config.roi_margin_cells + 2) * config.cell_size > map_half:
         raise InputError(creature.name, "legs", f"the creature (reach {span:.2f} m) is too large for its "
                          f"{config.map_cells} x {config.map_cells} local map of {config.cell_size} m cells")

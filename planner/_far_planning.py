@@ -36,13 +36,21 @@ import math
 from footfall.planner._params import PlannerConfig
 
 
-def compact_map_cells(config: PlannerConfig, span_m: float) -> int:
+def map_cells_holding(config: PlannerConfig, span_m: float) -> int:
     """The fewest (even) cells per side of a local map that holds every region of interest of a
     creature whose feet plan up to ``span_m`` (m) from its centre: the check of
-    ``planner._crowd.init_crowd`` (the span, the margin and two cells of dilation), exactly met."""
+    ``planner._crowd.init_crowd`` (the span, the margin and two cells of dilation), exactly met.
+
+    >>> map_cells_holding(PlannerConfig(), 1.0)       # (1.0 + 8 x 0.07) / 0.07 = 22.3 -> 2 x 23
+    46
+    """
     need = span_m + (config.roi_margin_cells + 2) * config.cell_size
-    cells = 2 * math.ceil(need / config.cell_size)
-    return min(config.map_cells, max(cells, 4))
+    return 2 * math.ceil(need / config.cell_size)
+
+
+def compact_map_cells(config: PlannerConfig, span_m: float) -> int:
+    """:func:`map_cells_holding`, at most the planner's own maps (and at least 4 cells)."""
+    return min(config.map_cells, max(map_cells_holding(config, span_m), 4))
 
 
 def far_configs(config: PlannerConfig, span_m: float, radius_cells: int, margin_cells: int,

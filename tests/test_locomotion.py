@@ -229,3 +229,29 @@ def test_a_tiny_creature_is_capped_to_a_gait_the_frames_can_draw(monkeypatch):
     summary = simulate(model, state, 150)
     assert summary.leg_crossings == 0 and summary.speed_reached > 0.9 * model.speed_cap
     assert summary.stride_rel_error_p90 < 0.25
+
+
+GIANT = Path(__file__).parent / "data" / "creatures" / "giant.toml"
+
+
+def test_a_creature_too_large_for_the_papers_maps_gets_maps_that_hold_it():
+    # The crab at 1.5 times its size plans its feet up to 2.02 m from its centre: with the paper's 70 x 70
+    # maps of 7 cm (2.45 m either side, less the margin) init_crowd refused it; its maps now have 74 cells.
+    from footfall import InputError
+    from footfall.planner import PlannerConfig, planner_config_for
+    from footfall.planner._crowd import init_crowd, planning_span
+    from footfall.planner._simulation import simulate
+    from footfall.scenarios import load_scenario
+    from footfall.scenarios._gait_choice import resolve_gait
+
+    giant = load_creature(str(GIANT))
+    config = planner_config_for(giant)
+    span = planning_span(giant, config)
+    assert config.map_cells == 74 and config.cell_size == 0.07
+    assert span + 8 * 0.07 <= 0.5 * 74 * 0.07 < span + 8 * 0.07 + 0.07  # the fewest even cells that hold it
+    gait, _, _ = resolve_gait(None, giant)
+    with pytest.raises(InputError, match="too large for its 70 x 70 local map"):
+        init_crowd(load_scenario("flat"), giant, gait, n_characters=1, config=PlannerConfig())
+    model, state = init_crowd(load_scenario("crates"), giant, gait, n_characters=2, seed=0)
+    summary = simulate(model, state, 60)
+    assert summary.finite and summary.collisions == 0 and summary.leg_crossings == 0 and summary.steps > 0
