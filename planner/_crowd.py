@@ -2801,6 +2801,14 @@ def planning_span(creature, config: PlannerConfig) -> float:
     return float(creature.rest_radius) + config.search_radius_m + float(np.max(creature.leg_reach))
 
 
+FOOT_GAP_CELLS = 2.5
+"""Cells at least between a creature's two nearest rest feet (``planner_config_for``): with fewer, the
+other legs' rooms block the cells round a preferred footprint. Random creatures of 6-8 legs with 0.9-1.4
+cells between neighbouring rest feet failed 84 of 90 ``footfall evaluate`` runs (per-stride p90 0.43-0.62,
+thousands of crossing frames); those with 2.6-3.3 cells, and every built-in creature (2.6-6.7; the mite at
+the 1 cm floor, 2.0), few or none (docs/locomotion.md, session 63)."""
+
+
 def planner_config_for(creature) -> PlannerConfig:
     """The paper's 70 x 70 maps of 7 cm cells, with finer cells (and a smaller candidate disc)
     for creatures too small for 7 cm: about four cells from the body centre to a rest foot; and
@@ -2809,7 +2817,8 @@ def planner_config_for(creature) -> PlannerConfig:
     Parameters
     ----------
     creature : scenarios.Creature
-        Its ``rest_radius`` (m) sets the cell size: a quarter of it rounded to 5 mm, between
+        Its ``rest_radius`` (m) sets the cell size: a quarter of it rounded to 5 mm, at most the
+        nearest two rest feet's gap over :data:`FOOT_GAP_CELLS` (rounded down to 5 mm), between
         1 and 7 cm; the candidate disc's radius is 0.75 rest radii, at most 25 cm. Its
         :func:`planning_span` sets the cells per side: 70, or as many as hold it (a creature of
         0.82 m rest radius and 0.89 m legs: 74; the planning cost grows with their square).
@@ -2831,7 +2840,13 @@ def planner_config_for(creature) -> PlannerConfig:
     from footfall.planner._far_planning import map_cells_holding
 
     rest = float(creature.rest_radius)
-    cell = min(0.07, max(0.01, round(rest / 4.0 / 0.005) * 0.005))
+    cell = round(rest / 4.0 / 0.005) * 0.005
+    feet = np.asarray(creature.rest_feet, dtype=np.float64)
+    if len(feet) > 1:
+        gaps = np.hypot(feet[:, None, 0] - feet[None, :, 0], feet[:, None, 1] - feet[None, :, 1])
+        gap = float(gaps[~np.eye(len(feet), dtype=np.bool_)].min())
+        cell = min(cell, math.floor(gap / FOOT_GAP_CELLS / 0.005) * 0.005)
+    cell = min(0.07, max(0.01, cell))
     config = PlannerConfig(cell_size=cell, search_radius_m=min(0.25, 0.75 * rest))
     cells = map_cells_holding(config, planning_span(creature, config))
     return config if cells <= config.map_cells else dataclasses.replace(config, map_cells=cells)

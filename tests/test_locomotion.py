@@ -255,3 +255,30 @@ def test_a_creature_too_large_for_the_papers_maps_gets_maps_that_hold_it():
     model, state = init_crowd(load_scenario("crates"), giant, gait, n_characters=2, seed=0)
     summary = simulate(model, state, 60)
     assert summary.finite and summary.collisions == 0 and summary.leg_crossings == 0 and summary.steps > 0
+
+
+DENSE8 = Path(__file__).parent / "data" / "creatures" / "dense8.toml"
+
+
+def test_a_creature_s_cells_leave_room_between_its_nearest_feet():
+    # dense8's nearest rest feet are 2.1 cm apart: a quarter of its rest radius (2 cm cells) put them a
+    # cell apart, and the other legs' rooms blocked the cells round each footprint (alone on flat, seed
+    # 13200: 77 holds, per-stride p90 0.90). Its cells are now 1 cm (the floor); the built-in creatures'
+    # are what a quarter of their rest radius gives (their feet are 2.6-6.7 of those cells apart).
+    from footfall.planner import planner_config_for
+    from footfall.planner._crowd import FOOT_GAP_CELLS
+    from footfall.planner._simulation import simulate
+    from footfall.planner._crowd import init_crowd
+    from footfall.scenarios import load_scenario
+    from footfall.scenarios._gait_choice import resolve_gait
+
+    cells = {name: planner_config_for(load_creature(name)).cell_size for name in ("spider", "ant", "quadruped", "robot5")}
+    assert cells == {"spider": 0.07, "ant": 0.04, "quadruped": 0.07, "robot5": 0.07}
+    dense = load_creature(str(DENSE8))
+    feet = np.asarray(dense.rest_feet)
+    gap = min(np.hypot(*(a - b)) for i, a in enumerate(feet) for b in feet[i + 1:])
+    assert planner_config_for(dense).cell_size == 0.01 and gap / 0.01 < FOOT_GAP_CELLS  # at the 1 cm floor
+    gait, _, _ = resolve_gait(None, dense)
+    model, state = init_crowd(load_scenario("flat"), dense, gait, n_characters=1, seed=13200)
+    summary = simulate(model, state, 150)
+    assert summary.holds < 20 and summary.leg_crossings == 0
