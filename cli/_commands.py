@@ -855,9 +855,9 @@ def matrix_table(matrix: dict) -> Table:
 def scoring_scales_note(rest_radius: float) -> str:
     """How the default scoring weights' metre scales fit a creature of ``rest_radius`` (m)
     (``planner.default_weights``): what ``footfall check`` says of a creature file."""
-    from footfall.planner import REFERENCE_REST_RADIUS_M
+    from footfall.planner._weights import size_factor
 
-    k = rest_radius / REFERENCE_REST_RADIUS_M
+    k = size_factor(rest_radius)
     if k < 1.0:
         return f"the scoring's metre scales x{k:.2f} of the spider's"
     return "the scoring's metre scales the spider's"

@@ -152,13 +152,27 @@ REFERENCE_REST_RADIUS_M = 0.35539095170112855
 built-in spider's, ``scenarios.Creature.rest_radius``)."""
 
 
+def size_factor(rest_radius_m: float) -> float:
+    """The factor on ``ScoringWeights()``'s metre-valued scales in a creature's defaults
+    (:func:`default_weights`): its rest radius over :data:`REFERENCE_REST_RADIUS_M`, at most 1.
+
+    >>> size_factor(REFERENCE_REST_RADIUS_M / 2), size_factor(2 * REFERENCE_REST_RADIUS_M)
+    (0.5, 1.0)
+    """
+    if isinstance(rest_radius_m, bool) or not isinstance(rest_radius_m, (int, float, np.floating, np.integer)) \
+            or not math.isfinite(rest_radius_m) or rest_radius_m <= 0:
+        raise ValueError(f"rest_radius_m: expected a finite number > 0, got {rest_radius_m!r}")
+    return min(1.0, float(rest_radius_m) / REFERENCE_REST_RADIUS_M)
+
+
 def default_weights(rest_radius_m: float) -> ScoringWeights:
     """The default scoring weights of a creature of rest radius ``rest_radius_m``: the runtime's and
     the tunes' starting point for it.
 
     The same goodness laws at every size up to the spider's: for a smaller creature each metre-valued
     reference scale (:data:`METRE_SCALE_FIELDS`: distance, height step, leg spacing, proximity,
-    clearance, climb) is ``ScoringWeights()``'s times ``rest_radius_m / REFERENCE_REST_RADIUS_M``; the
+    clearance, climb) is ``ScoringWeights()``'s times :func:`size_factor`, ``rest_radius_m /
+    REFERENCE_REST_RADIUS_M``; the
     weights and the scale-free references (slope, curvature energy, jerk) stay. Why: with the spider's
     7 cm clearance a 12 cm beetle's every swing path scored as near another leg's room, the clearance
     term outvoted the distance to its preferred footprint, and 16 % of its strides landed a 3 cm cell
@@ -197,10 +211,7 @@ def default_weights(rest_radius_m: float) -> ScoringWeights:
         ...
     ValueError: rest_radius_m: expected a finite number > 0, got 0.0
     """
-    if isinstance(rest_radius_m, bool) or not isinstance(rest_radius_m, (int, float, np.floating, np.integer)) \
-            or not math.isfinite(rest_radius_m) or rest_radius_m <= 0:
-        raise ValueError(f"rest_radius_m: expected a finite number > 0, got {rest_radius_m!r}")
-    k = min(1.0, float(rest_radius_m) / REFERENCE_REST_RADIUS_M)
+    k = size_factor(rest_radius_m)
     defaults = ScoringWeights()
     if k == 1.0:
         return defaults

@@ -172,7 +172,8 @@ def test_duty_factor_falls_with_speed_and_the_quadruped_trots_when_fast():
     assert fast.gait_fractions["quadruped-trot"] > 0.9
 
 
-BEETLE = Path(__file__).parent / "data" / "creatures" / "beetle.toml"
+CREATURES = Path(__file__).parent / "data" / "creatures"  # creatures no built-in scenario names
+BEETLE = CREATURES / "beetle.toml"
 OFF_PREFERRED_M = 0.005  # a new swing's footprint this far from its preferred one counts as moved off it
 OFF_PREFERRED_SHARE = 0.05  # on flat ground at most this share of new swings moves off (spider 2 %, ant 0 %)
 
@@ -207,10 +208,10 @@ def test_a_small_creature_alone_on_flat_ground_lands_on_its_preferred_footprints
     assert share <= OFF_PREFERRED_SHARE, f"{share:.0%} of {off.size} new swings land over 5 mm off; largest {off.max():.4f} m"
 
 
-MITE = Path(__file__).parent / "data" / "creatures" / "mite.toml"
+MITE = CREATURES / "mite.toml"
 
 
-def test_a_tiny_creature_is_capped_to_a_gait_the_frames_can_draw(monkeypatch):
+def test_a_tiny_creature_is_capped_to_a_gait_the_frames_can_draw():
     # A 3 cm mite asked the scenarios' 0.3 m/s would step at 11.8 Hz, a stride cycle of 2.5 frames: its
     # swings last under a frame and its legs are drawn across each other (six mites, 300 frames on flat:
     # 65 crossing frames over seeds 13000-13004). Capped where a cycle lasts 4 frames (0.097 m/s): none.
@@ -231,7 +232,7 @@ def test_a_tiny_creature_is_capped_to_a_gait_the_frames_can_draw(monkeypatch):
     assert summary.stride_rel_error_p90 < 0.25
 
 
-GIANT = Path(__file__).parent / "data" / "creatures" / "giant.toml"
+GIANT = CREATURES / "giant.toml"
 
 
 def test_a_creature_too_large_for_the_papers_maps_gets_maps_that_hold_it():
@@ -257,7 +258,7 @@ def test_a_creature_too_large_for_the_papers_maps_gets_maps_that_hold_it():
     assert summary.finite and summary.collisions == 0 and summary.leg_crossings == 0 and summary.steps > 0
 
 
-DENSE8 = Path(__file__).parent / "data" / "creatures" / "dense8.toml"
+DENSE8 = CREATURES / "dense8.toml"
 
 
 def test_a_creature_s_cells_leave_room_between_its_nearest_feet():
@@ -266,9 +267,8 @@ def test_a_creature_s_cells_leave_room_between_its_nearest_feet():
     # 13200: 77 holds, per-stride p90 0.90). Its cells are now 1 cm (the floor); the built-in creatures'
     # are what a quarter of their rest radius gives (their feet are 2.6-6.7 of those cells apart).
     from footfall.planner import planner_config_for
-    from footfall.planner._crowd import FOOT_GAP_CELLS
+    from footfall.planner._crowd import FOOT_GAP_CELLS, init_crowd
     from footfall.planner._simulation import simulate
-    from footfall.planner._crowd import init_crowd
     from footfall.scenarios import load_scenario
     from footfall.scenarios._gait_choice import resolve_gait
 

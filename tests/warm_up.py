@@ -48,7 +48,6 @@ main(["simulate", "mixed", "--frames", "3", "--characters", "4", "--json"])  # t
 """
 
 
-
 def compile_kernels() -> list[str]:
     """Compile the kernels in two processes (cache: ``NUMBA_CACHE_DIR``, as
     :func:`footfall.configure_numba_cache` sets it); returns the last line of each failed process's stderr."""
