@@ -283,6 +283,10 @@ class CrowdModel:
     schedule: object = None  # planner._gait_schedule.GaitSchedule: the gaits by speed (gait: the slowest)
     stance_window: np.ndarray | None = None  # (L, 2) body-forward interval each leg carries a stance foot over
     speed_cap: float = math.inf  # m/s, the fastest speed the legs carry at the stride law (planner._workspace)
+    # What sets speed_cap: 'windows' (the least duty factor's sweep fills the narrowest stance window),
+    # 'frames' (a stride cycle would last under MIN_CYCLE_FRAMES) or 'territories' (a sweep would reach a
+    # neighbouring leg's territory): planner._workspace.
+    speed_cap_reason: str = "windows"
     speed_asked: float = 0.0  # m/s, the scenario's speed before the cap
     step_height: float = 0.0  # m, the swings' preferred lift (paper §3.1 'step height')
     # m/s, the fastest a character walks to get out of the way (of a box, of another): its speed
@@ -2810,6 +2814,13 @@ cells, and every built-in creature (2.6-6.7; the mite at the 1 cm floor, 2.0), f
 (docs/locomotion.md, session 63)."""
 
 
+MIN_CELL_M = 0.005
+"""m, the finest cells ``planner_config_for`` gives. At 1 cm, random creatures whose nearest rest feet were
+2.1-2.7 cm apart (``FOOT_GAP_CELLS`` asks 0.8-1.1 cm cells) had their footprints pushed a cell back off
+their neighbours' rooms: per-stride p90 0.23-0.31 on every built-in scenario, 0.07-0.20 at 5 mm
+(docs/locomotion.md, session 64)."""
+
+
 def planner_config_for(creature) -> PlannerConfig:
     """The paper's 70 x 70 maps of 7 cm cells, with finer cells (and a smaller candidate disc)
     for creatures too small for 7 cm: about four cells from the body centre to a rest foot; and
@@ -2820,7 +2831,7 @@ def planner_config_for(creature) -> PlannerConfig:
     creature : scenarios.Creature
         Its ``rest_radius`` (m) sets the cell size: a quarter of it rounded to 5 mm, at most the
         nearest two rest feet's gap over :data:`FOOT_GAP_CELLS` (rounded down to 5 mm), between
-        1 and 7 cm; the candidate disc's radius is 0.75 rest radii, at most 25 cm. Its
+        :data:`MIN_CELL_M` and 7 cm; the candidate disc's radius is 0.75 rest radii, at most 25 cm. Its
         :func:`planning_span` sets the cells per side: 70, or as many as hold it (a creature of
         0.82 m rest radius and 0.89 m legs: 74; the planning cost grows with their square).
 
@@ -2847,7 +2858,7 @@ def planner_config_for(creature) -> PlannerConfig:
         gaps = np.hypot(feet[:, None, 0] - feet[None, :, 0], feet[:, None, 1] - feet[None, :, 1])
         gap = float(gaps[~np.eye(len(feet), dtype=np.bool_)].min())
         cell = min(cell, math.floor(gap / FOOT_GAP_CELLS / 0.005) * 0.005)
-    cell = min(0.07, max(0.01, cell))
+    cell = min(0.07, max(MIN_CELL_M, cell))
     config = PlannerConfig(cell_size=cell, search_radius_m=min(0.25, 0.75 * rest))
     cells = map_cells_holding(config, planning_span(creature, config))
     return config if cells <= config.map_cells else dataclasses.replace(config, map_cells=cells)
@@ -2976,15 +2987,17 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         raise ValueError(f"raster: cell size {raster.frame.cell_size} differs from the planner's {config.cell_size}")
     from footfall.planner._gait_schedule import as_schedule
     from footfall.planner._timing import GRAVITY, hip_height
-    from footfall.planner._workspace import frame_rate_cap, height_ranges, speed_cap, stance_windows, tuck_reaches
+    from footfall.planner._workspace import height_ranges, speed_caps, stance_windows, tuck_reaches
 
     schedule = as_schedule(gait)
     window = stance_windows(creature, rest_body, hips_body, leg_static)
     # Past this speed even the least duty factor's stance sweep does not fit the legs' windows, or a
-    # stride cycle lasts under MIN_CYCLE_FRAMES frames (a tiny creature): the controller caps the
-    # speed there (reported as speed_cap; the CLI says so).
-    cap = min(speed_cap(timing, hip_height(creature), float(np.min(window[:, 1] - window[:, 0]))),
-              frame_rate_cap(timing, hip_height(creature), DT))
+    # stride cycle lasts under MIN_CYCLE_FRAMES frames (a tiny creature), or a stance sweep reaches
+    # into a neighbouring leg's territory (dense legs): the controller caps the speed there (reported
+    # as speed_cap; the CLI says so).
+    caps = speed_caps(timing, hip_height(creature), rest_body, hips_body, window, DT)
+    cap_reason = min(caps, key=caps.get)
+    cap = caps[cap_reason]
     speed = min(speed_asked, cap)
     escape = min(cap, math.sqrt(ESCAPE_FROUDE * GRAVITY * hip_height(creature)))
     far_first, far_fallback = None, None
@@ -2998,6 +3011,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         lod_mode=lod_mode, raster=raster, camera=scenario.camera, dt=DT, feet_spacing=spacing,
         hips_body=hips_body, rest_body=rest_body, reach=np.asarray(creature.leg_reach, dtype=np.float64),
         leg_static=leg_static, fixed_budget=budget, schedule=schedule, stance_window=window, speed_cap=cap,
+        speed_cap_reason=cap_reason,
         speed_asked=speed_asked, step_height=step_height, top_speed=max(escape, speed),
         height_range=height_ranges(creature, rest_body, hips_body, leg_static), far_first=far_first,
         tuck_reach=tuck_reaches(creature, rest_body, hips_body, leg_static, TUCK_REACHES, TUCK_LIFT),

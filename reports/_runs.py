@@ -33,9 +33,12 @@ def say_speed_cap(model) -> None:
     from footfall.planner._workspace import MIN_CYCLE_FRAMES
 
     if model.speed_asked > model.speed_cap:
+        why = {"windows": "its stance sweeps fit its legs' stance windows",
+               "frames": f"a stride cycle lasts at least {MIN_CYCLE_FRAMES} frames",
+               "territories": "each stance sweep keeps to its leg's territory, clear of the neighbouring legs"}
         print(f"footfall: note: {model.creature.name}: {model.speed_asked:g} m/s asked; speed capped at "
-              f"{model.speed_cap:.3g} m/s, the fastest its legs carry at the stride law in stride cycles of at "
-              f"least {MIN_CYCLE_FRAMES} frames", file=sys.stderr)
+              f"{model.speed_cap:.3g} m/s, the fastest its legs carry at the stride law where "
+              f"{why[model.speed_cap_reason]}", file=sys.stderr)
 
 
 def recording_meta(scenario, seed: int, lod: str, gait, navigate: bool = True) -> dict:

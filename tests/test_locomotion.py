@@ -264,10 +264,11 @@ DENSE8 = CREATURES / "dense8.toml"
 def test_a_creature_s_cells_leave_room_between_its_nearest_feet():
     # dense8's nearest rest feet are 2.1 cm apart: a quarter of its rest radius (2 cm cells) put them a
     # cell apart, and the other legs' rooms blocked the cells round each footprint (alone on flat, seed
-    # 13200: 77 holds, per-stride p90 0.90). Its cells are now 1 cm (the floor); the built-in creatures'
-    # are what a quarter of their rest radius gives (their feet are 2.6-6.7 of those cells apart).
+    # 13200: 77 holds, per-stride p90 0.90). Its cells are now 5 mm (MIN_CELL_M; 1 cm, the floor until
+    # session 64, left 2.1 cells between those feet); the built-in creatures' are what a quarter of their
+    # rest radius gives (their feet are 2.6-6.7 of those cells apart).
     from footfall.planner import planner_config_for
-    from footfall.planner._crowd import FOOT_GAP_CELLS, init_crowd
+    from footfall.planner._crowd import FOOT_GAP_CELLS, MIN_CELL_M, init_crowd
     from footfall.planner._simulation import simulate
     from footfall.scenarios import load_scenario
     from footfall.scenarios._gait_choice import resolve_gait
@@ -277,8 +278,39 @@ def test_a_creature_s_cells_leave_room_between_its_nearest_feet():
     dense = load_creature(str(DENSE8))
     feet = np.asarray(dense.rest_feet)
     gap = min(np.hypot(*(a - b)) for i, a in enumerate(feet) for b in feet[i + 1:])
-    assert planner_config_for(dense).cell_size == 0.01 and gap / 0.01 < FOOT_GAP_CELLS  # at the 1 cm floor
+    assert planner_config_for(dense).cell_size == MIN_CELL_M == 0.005 and gap / MIN_CELL_M >= FOOT_GAP_CELLS
     gait, _, _ = resolve_gait(None, dense)
     model, state = init_crowd(load_scenario("flat"), dense, gait, n_characters=1, seed=13200)
     summary = simulate(model, state, 150)
     assert summary.holds < 20 and summary.leg_crossings == 0
+
+
+SPLAY8 = CREATURES / "splay8.toml"
+
+
+@pytest.mark.parametrize("name", ["splay8", "dense8"])
+def test_dense_legs_walk_no_faster_than_their_stance_sweeps_keep_to_their_territories(name):
+    # Legs 4-7 cm apart along a side (splay8) or 2-3 cm (dense8), whose stride law asks longer stance
+    # sweeps: a hind foot landed in front of the next leg's line and the legs were drawn across each
+    # other (four splay8 on flat, seed 2, 150 frames: 39 crossing frames, 15 holds), or was pushed off its
+    # footprint by its neighbours' rooms (dense8: per-stride p90 0.64). The speed is now capped where a
+    # sweep first reaches a neighbour's territory (planner._workspace.territory_speed_cap): 0.09 m/s.
+    from footfall.planner._crowd import init_crowd
+    from footfall.planner._simulation import simulate
+    from footfall.planner._timing import hip_height
+    from footfall.planner._crowd import DT
+    from footfall.planner._workspace import speed_caps
+    from footfall.scenarios import load_scenario
+    from footfall.scenarios._gait_choice import resolve_gait
+
+    creature = load_creature(str(SPLAY8 if name == "splay8" else DENSE8))
+    gait, _, _ = resolve_gait(None, creature)
+    model, state = init_crowd(load_scenario("flat"), creature, gait, n_characters=4, seed=2)
+    caps = speed_caps(model.timing, hip_height(creature), model.rest_body, model.hips_body, model.stance_window, DT)
+    assert model.speed_cap_reason == "territories" and model.speed_cap == caps["territories"] < 0.1
+    assert caps["territories"] < 0.5 * min(caps["windows"], caps["frames"])
+    summary = simulate(model, state, 150)
+    assert summary.leg_crossings == 0 and summary.holds <= 2
+    assert summary.speed_reached > 0.7 * model.speed_cap  # measured 0.78 (splay8) and 1.0 (dense8)
+    if name == "dense8":  # its strides: the flat-ground bar of footfall evaluate is p90 0.15
+        assert summary.stride_rel_error_p90 < 0.15
