@@ -2810,7 +2810,7 @@ FOOT_GAP_CELLS = 2.5
 other legs' rooms block the cells round a preferred footprint. Random creatures of 6-8 legs with 0.9-1.4
 cells between neighbouring rest feet failed 90 of 90 ``footfall evaluate`` runs (per-stride p90 0.43-0.62,
 thousands of crossing frames; 80 with this rule, their crossing frames 17,155 -> 6,792); those with 2.6-3.3
-cells, and every built-in creature (2.6-6.7; the mite at the 1 cm floor, 2.0), few or none
+cells, and every built-in creature (2.6-6.7; the mite 2.0 at the 1 cm floor then, 4.0 at MIN_CELL_M), few or none
 (docs/locomotion.md, session 63)."""
 
 
