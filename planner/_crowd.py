@@ -2815,9 +2815,9 @@ cells, and every built-in creature (2.6-6.7; the mite 2.0 at the 1 cm floor then
 
 
 MIN_CELL_M = 0.005
-"""m, the finest cells ``planner_config_for`` gives. At 1 cm, random creatures whose nearest rest feet were
-2.1-2.7 cm apart (``FOOT_GAP_CELLS`` asks 0.8-1.1 cm cells) had their footprints pushed a cell back off
-their neighbours' rooms: per-stride p90 0.23-0.31 on every built-in scenario, 0.07-0.20 at 5 mm
+"""m, the finest cells ``planner_config_for`` gives. At 1 cm, two random creatures whose nearest rest feet
+are 2.0 and 2.1 cm apart (``FOOT_GAP_CELLS`` asks 0.8-0.9 cm cells) had their footprints pushed a cell back
+off their neighbours' rooms: per-stride p90 0.18-0.32 on every built-in scenario, 0.07-0.20 at 5 mm
 (docs/locomotion.md, session 64)."""
 
 
