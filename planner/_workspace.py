@@ -204,11 +204,11 @@ def territory_bounds(rest_body: np.ndarray, hips_body: np.ndarray) -> np.ndarray
 
     Two legs adjacent on one side (ordered by their rest feet's forward coordinate) share the line
     from the midpoint of their hips to the midpoint of their rest feet; the front leg's territory ends
-    behind at it, the rear leg's ahead. A foot that keeps to its territory keeps its leg's line on the
-    ground clear of its neighbours' (dense legs drawn across each other otherwise: see
-    :func:`territory_speed_cap`). ``-inf`` / ``inf`` where a leg has no neighbour on that side, for legs
-    on the midline (hip within 1e-3 of the widest hip's lateral offset) and for a line parallel to the
-    body's axis.
+    behind at it, the rear leg's ahead. Feet that keep to their territories keep their legs' straight
+    lines on the ground apart (dense legs were drawn across each other otherwise: see
+    :func:`territory_speed_cap`); legs drawn bowed, with knees out, can still pass near each other.
+    ``-inf`` / ``inf`` where a leg has no neighbour on that side, for legs on the midline (a hip's
+    lateral offset under 1e-3 of the widest one's) and for a shared line parallel to the body's axis.
 
     Parameters
     ----------
