@@ -295,10 +295,9 @@ def test_dense_legs_walk_no_faster_than_their_stance_sweeps_keep_to_their_territ
     # other (four splay8 on flat, seed 2, 150 frames: 39 crossing frames, 15 holds), or was pushed off its
     # footprint by its neighbours' rooms (dense8: per-stride p90 0.64). The speed is now capped where a
     # sweep first reaches a neighbour's territory (planner._workspace.territory_speed_cap): 0.09 m/s.
-    from footfall.planner._crowd import init_crowd
+    from footfall.planner._crowd import DT, init_crowd
     from footfall.planner._simulation import simulate
     from footfall.planner._timing import hip_height
-    from footfall.planner._crowd import DT
     from footfall.planner._workspace import speed_caps
     from footfall.scenarios import load_scenario
     from footfall.scenarios._gait_choice import resolve_gait
