@@ -324,9 +324,10 @@ class CrowdModel:
     @cached_property
     def leg_sides(self) -> np.ndarray:
         """(L,) each leg's side of the body's midline: +1 left, -1 right, 0 for a hip on the midline
-        (within 1e-3 rest radii: a robot5's front leg)."""
-        lateral = self.hips_body[:, 2]
-        return np.sign(lateral) * (np.abs(lateral) > 1e-3 * self.rest_radius)
+        (within 1e-3 rest radii: a robot5's front leg; planner._workspace.leg_sides)."""
+        from footfall.planner._workspace import leg_sides
+
+        return leg_sides(self.hips_body, self.rest_body)
 
     @property
     def rest_radius(self) -> float:

@@ -198,6 +198,22 @@ def speed_cap(timing, leg_height: float, window: float) -> float:
 
 
 
+def leg_sides(hips_body: np.ndarray, rest_body: np.ndarray) -> np.ndarray:
+    """(L,) each leg's side of the body's midline: +1 left, -1 right, 0 for a hip on the midline
+    (within 1e-3 rest radii of it: a robot5's front leg). ``CrowdModel.leg_sides``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> hips = np.array([[0.1, 0.0, 0.05], [0.1, 0.0, -0.05], [0.2, 0.0, 1e-5]])
+    >>> leg_sides(hips, np.array([[0.2, 0.3], [0.2, -0.3], [0.4, 0.0]])).tolist()
+    [1.0, -1.0, 0.0]
+    """
+    lateral = np.asarray(hips_body, dtype=np.float64)[:, 2]
+    rest_radius = float(np.max(np.hypot(rest_body[:, 0], rest_body[:, 1])))
+    return np.sign(lateral) * (np.abs(lateral) > 1e-3 * rest_radius)
+
+
 def territory_bounds(rest_body: np.ndarray, hips_body: np.ndarray) -> np.ndarray:
     """(L, 2) each leg's **territory**: the body-forward interval, at its rest foot's lateral
     coordinate, between the lines that halve the gaps to its same-side neighbours.
@@ -207,8 +223,8 @@ def territory_bounds(rest_body: np.ndarray, hips_body: np.ndarray) -> np.ndarray
     behind at it, the rear leg's ahead. Feet that keep to their territories keep their legs' straight
     lines on the ground apart (dense legs were drawn across each other otherwise: see
     :func:`territory_speed_cap`); legs drawn bowed, with knees out, can still pass near each other.
-    ``-inf`` / ``inf`` where a leg has no neighbour on that side, for legs on the midline (a hip's
-    lateral offset under 1e-3 of the widest one's) and for a shared line parallel to the body's axis.
+    ``-inf`` / ``inf`` where a leg has no neighbour on that side, for legs on the midline
+    (:func:`leg_sides`) and for a shared line parallel to the body's axis.
 
     Parameters
     ----------
@@ -242,11 +258,8 @@ def territory_bounds(rest_body: np.ndarray, hips_body: np.ndarray) -> np.ndarray
     """
     rest_body = np.asarray(rest_body, dtype=np.float64)
     hips_body = np.asarray(hips_body, dtype=np.float64)
-    n = rest_body.shape[0]
-    bounds = np.tile(np.array([-np.inf, np.inf]), (n, 1))
-    lateral = hips_body[:, 2]
-    widest = float(np.max(np.abs(lateral), initial=0.0))
-    side = np.sign(lateral) * (np.abs(lateral) > 1e-3 * widest)
+    bounds = np.tile(np.array([-np.inf, np.inf]), (rest_body.shape[0], 1))
+    side = leg_sides(hips_body, rest_body)
     for s in (-1.0, 1.0):
         legs = np.flatnonzero(side == s)
         legs = legs[np.argsort(-rest_body[legs, 0], kind="stable")]  # front to back
@@ -255,9 +268,9 @@ def territory_bounds(rest_body: np.ndarray, hips_body: np.ndarray) -> np.ndarray
             foot = 0.5 * (rest_body[front] + rest_body[rear])
             if abs(foot[1] - hip[1]) < 1e-12:
                 continue
+            # Sorted along the side, each leg has one neighbour ahead and one behind: one line per end.
             for leg, end in ((front, 0), (rear, 1)):
-                forward = hip[0] + (rest_body[leg, 1] - hip[1]) / (foot[1] - hip[1]) * (foot[0] - hip[0])
-                bounds[leg, end] = max(bounds[leg, end], forward) if end == 0 else min(bounds[leg, end], forward)
+                bounds[leg, end] = hip[0] + (rest_body[leg, 1] - hip[1]) / (foot[1] - hip[1]) * (foot[0] - hip[0])
     return bounds
 
 
