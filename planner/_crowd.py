@@ -284,8 +284,9 @@ class CrowdModel:
     stance_window: np.ndarray | None = None  # (L, 2) body-forward interval each leg carries a stance foot over
     speed_cap: float = math.inf  # m/s, the fastest speed the legs carry at the stride law (planner._workspace)
     # What sets speed_cap: 'windows' (the least duty factor's sweep fills the narrowest stance window),
-    # 'frames' (a stride cycle would last under MIN_CYCLE_FRAMES) or 'territories' (a sweep would reach a
-    # neighbouring leg's territory): planner._workspace.
+    # 'frames' (a stride cycle would last under MIN_CYCLE_FRAMES), 'territories' (a sweep would reach a
+    # neighbouring leg's territory) or 'neighbours' (a landing spot would come within a foot's room of the
+    # neighbouring leg's lift-off spot): planner._workspace.
     speed_cap_reason: str = "windows"
     speed_asked: float = 0.0  # m/s, the scenario's speed before the cap
     step_height: float = 0.0  # m, the swings' preferred lift (paper §3.1 'step height')
@@ -756,7 +757,7 @@ def shove_out_of_moving_boxes(model: CrowdModel, state: CrowdState, boxes, neigh
     half = 0.5 * sizes[index][:, [0, 2]]
     reach = model.rest_radius + np.hypot(half[:, 0], half[:, 1])
     close = np.hypot(*(xz[:, None, :] - centres[index][None, :, [0, 2]]).transpose(2, 0, 1)) < reach[None]
-    need = 0.5 * math.hypot(model.creature.foot_length, model.creature.foot_width) + SHOVE_MARGIN
+    need = 0.5 * model.creature.foot_room + SHOVE_MARGIN
     shoved = np.zeros(xz.shape[0], np.bool_)
     pairs = np.nonzero(close)
     if not pairs[0].size:
@@ -792,7 +793,7 @@ def shove_out_of_moving_boxes(model: CrowdModel, state: CrowdState, boxes, neigh
 
 def _landings_shoved_onto_feet(model: CrowdModel, state: CrowdState) -> None:
     """Mark (``state.shoved_onto_feet``) the feet in the air of shoved bodies whose landing spot, carried
-    along by the shove, is now within a foot's room (:func:`_foot_room`, the search's) of another character's
+    along by the shove, is now within a foot's room (``Creature.foot_room``, the search's) of another character's
     foot, where it stands or will land: they plan again (``stage_requests``). Re-planning every foot in
     the air of a shoved body instead made the pelvis jump 8-9 cm (it follows the landing spots), against
     2-3 cm (mixed, 64 ants, seeds 2 and 3)."""
@@ -806,7 +807,7 @@ def _landings_shoved_onto_feet(model: CrowdModel, state: CrowdState) -> None:
     support = np.ascontiguousarray(_landing_feet(state)[..., [0, 2]].reshape(-1, 2))
     owner = np.repeat(np.arange(n_chars), n_legs)
     start, _ = points_near(support, owner, np.ascontiguousarray(state.swing_target[cs, ls][:, [0, 2]]),
-                           np.ascontiguousarray(cs, dtype=np.int64), _foot_room(model))
+                           np.ascontiguousarray(cs, dtype=np.int64), model.creature.foot_room)
     taken = np.diff(start) > 0
     state.shoved_onto_feet[cs[taken], ls[taken]] = True
 
@@ -1569,12 +1570,6 @@ def _reach_xz(model: CrowdModel, legs=slice(None), drop=None) -> np.ndarray:
     return np.sqrt(np.maximum(reach**2 - dy**2, (0.2 * reach) ** 2))
 
 
-def _foot_room(model: CrowdModel) -> float:
-    """m, the room a planned foot keeps from every other foot (the search's ``block_radius``): the
-    foot's diagonal."""
-    return math.hypot(model.creature.foot_length, model.creature.foot_width)
-
-
 def paths_through_body(model: CrowdModel, state: CrowdState, cs, ls, trajectories, valid) -> np.ndarray:
     """(F,) bool: valid plans of legs (``cs``, ``ls``) whose swing path (``trajectories`` (F, K, 3))
     passes, alongside the body (within half its body box's length of the pelvis, along the heading),
@@ -1641,7 +1636,7 @@ def _same_frame_conflicts(model: CrowdModel, cs, targets, valid, hips=None) -> n
     from scipy.spatial import cKDTree
 
     idx = np.flatnonzero(valid)
-    radius = _foot_room(model)
+    radius = model.creature.foot_room
     pairs = cKDTree(targets[idx][:, [0, 2]]).query_pairs(radius, output_type="ndarray")
     if pairs.size:
         a, b = idx[pairs[:, 0]], idx[pairs[:, 1]]
@@ -1733,7 +1728,7 @@ def _with_neighbours_feet(model: CrowdModel, state: CrowdState, cs, own, drawn_r
         from footfall.planner._kernels_geometry import points_near
 
         owner = np.repeat(np.arange(n_chars), n_legs)
-        radius = model.config.search_radius_m + 2.0 * _foot_room(model)
+        radius = model.config.search_radius_m + 2.0 * model.creature.foot_room
         # The other characters' feet only, ascending (a grid kernel: the k-d tree's lists of lists cost
         # 3.4 ms a frame for 1000 spiders).
         found_start, near = points_near(np.ascontiguousarray(support[..., [0, 2]].reshape(-1, 2)), owner,
@@ -2182,7 +2177,7 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
         hips=np.ascontiguousarray(hip_pred), reach_xz=_reach_xz(model, ls, ground_drop),
         step_height=np.full(f, model.step_height),
         legs=legs, legs_start=legs_start,
-        block_radius=np.full(f, _foot_room(model)),
+        block_radius=np.full(f, model.creature.foot_room),
         couples_after_first=couples[cs], slice_size=slices[cs],
         # the paper's early termination (§5.2) always, unless a fixed budget says otherwise
         early=np.full(f, model.fixed_budget is None or model.fixed_budget.paper_early_stop, np.bool_))
@@ -2953,7 +2948,6 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         raise ValueError(f"budget: a fixed search budget needs lod_mode 'off', got {lod_mode!r}")
     config = config or planner_config_for(creature)
     controller = controller or ControllerConfig()
-    weights = weights or default_weights(creature.rest_radius)
     timing = timing or GaitTiming()
     lod = lod or LodConfig()
     n = int(n_characters or scenario.crowd.count)
@@ -2988,18 +2982,24 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         raise ValueError(f"raster: cell size {raster.frame.cell_size} differs from the planner's {config.cell_size}")
     from footfall.planner._gait_schedule import as_schedule
     from footfall.planner._timing import GRAVITY, hip_height
-    from footfall.planner._workspace import height_ranges, speed_caps, stance_windows, tuck_reaches
+    from footfall.planner._workspace import height_ranges, leg_room, speed_caps, stance_windows, tuck_reaches
 
     schedule = as_schedule(gait)
     window = stance_windows(creature, rest_body, hips_body, leg_static)
     # Past this speed even the least duty factor's stance sweep does not fit the legs' windows, or a
     # stride cycle lasts under MIN_CYCLE_FRAMES frames (a tiny creature), or a stance sweep reaches
-    # into a neighbouring leg's territory (dense legs): the controller caps the speed there (reported
-    # as speed_cap; the CLI says so).
-    caps = speed_caps(timing, hip_height(creature), rest_body, hips_body, window, DT)
+    # into a neighbouring leg's territory, or a landing spot within a foot's room of the neighbouring
+    # leg's lift-off spot (dense legs): the controller caps the speed there (reported as speed_cap; the
+    # CLI says so).
+    caps = speed_caps(timing, hip_height(creature), rest_body, hips_body, window, DT, creature.foot_room)
     cap_reason = min(caps, key=caps.get)
     cap = caps[cap_reason]
     speed = min(speed_asked, cap)
+    if weights is None:
+        # The leg-spacing reference no larger than the room the stride law leaves between neighbouring
+        # legs at this walk (planner.default_weights).
+        weights = default_weights(creature.rest_radius, leg_room(timing, hip_height(creature), rest_body, hips_body,
+                                                                  window, speed, creature.foot_room, DT))
     escape = min(cap, math.sqrt(ESCAPE_FROUDE * GRAVITY * hip_height(creature)))
     far_first, far_fallback = None, None
     if lod_mode != "off":
@@ -3142,7 +3142,7 @@ def _initial_feet(model: CrowdModel, positions, headings):
     fx, fz = _rot_xz(headings[:, None], model.rest_body[None, :, 0], model.rest_body[None, :, 1])
     fx = fx + positions[:, None, 0]
     fz = fz + positions[:, None, 1]
-    fx, fz = _spawned_feet_apart(fx, fz, _foot_room(model))
+    fx, fz = _spawned_feet_apart(fx, fz, model.creature.foot_room)
     rows, cols = r.frame.world_to_cell(fx, fz)
     rows = np.clip(rows, 1, r.frame.n_rows - 2)
     cols = np.clip(cols, 1, r.frame.n_cols - 2)

@@ -165,8 +165,9 @@ def size_factor(rest_radius_m: float) -> float:
     return min(1.0, float(rest_radius_m) / REFERENCE_REST_RADIUS_M)
 
 
-def default_weights(rest_radius_m: float) -> ScoringWeights:
-    """The default scoring weights of a creature of rest radius ``rest_radius_m``: the runtime's and
+def default_weights(rest_radius_m: float, leg_room_m: float = math.inf) -> ScoringWeights:
+    """The default scoring weights of a creature of rest radius ``rest_radius_m`` whose stride law leaves
+    ``leg_room_m`` between its neighbouring legs (:func:`planner._workspace.leg_room`): the runtime's and
     the tunes' starting point for it.
 
     The same goodness laws at every size up to the spider's: for a smaller creature each metre-valued
@@ -182,10 +183,18 @@ def default_weights(rest_radius_m: float) -> ScoringWeights:
     the stride law among crates and other crabs (per-stride p90 0.257 -> 0.287 on ``mixed``, 30 runs),
     while robot5 (1.2 times) was within the noise.
 
+    The leg-spacing reference (the gap that counts as enough room) is at most ``leg_room_m``: where the
+    stride law's own landing spots stand nearer than it to the neighbouring legs, every landing scored
+    as crowded and the search moved it back, off the law (random 8-legged creatures with rest feet 4 cm
+    apart: rear feet 1.3-2.9 cm short of 5 cm strides, per-stride p90 0.28-0.69). The built-in creatures'
+    law leaves more than their reference at the speeds they walk, and keeps it.
+
     Parameters
     ----------
     rest_radius_m : float
         The creature's rest radius (m, ``scenarios.Creature.rest_radius``), > 0.
+    leg_room_m : float, optional
+        The room (m, > 0) between neighbouring legs the stride law leaves (no limit by default).
 
     Returns
     -------
@@ -194,7 +203,7 @@ def default_weights(rest_radius_m: float) -> ScoringWeights:
     Raises
     ------
     ValueError
-        If ``rest_radius_m`` is not a finite number > 0.
+        If ``rest_radius_m`` is not a finite number > 0, or ``leg_room_m`` not a number > 0.
 
     Examples
     --------
@@ -206,16 +215,24 @@ def default_weights(rest_radius_m: float) -> ScoringWeights:
     (0.035, 0.15, 1.0, 3.0)
     >>> default_weights(2 * REFERENCE_REST_RADIUS_M) == ScoringWeights()  # larger: the spider's scales
     True
+    >>> default_weights(REFERENCE_REST_RADIUS_M, 0.02).leg_spacing_ref_m   # legs 2 cm apart at its walk
+    0.02
+    >>> default_weights(REFERENCE_REST_RADIUS_M, 0.2) == ScoringWeights()  # more room than the reference
+    True
     >>> default_weights(0.0)
     Traceback (most recent call last):
         ...
     ValueError: rest_radius_m: expected a finite number > 0, got 0.0
     """
     k = size_factor(rest_radius_m)
+    if isinstance(leg_room_m, bool) or not isinstance(leg_room_m, (int, float, np.floating, np.integer)) \
+            or not leg_room_m > 0:
+        raise ValueError(f"leg_room_m: expected a number > 0, got {leg_room_m!r}")
     defaults = ScoringWeights()
-    if k == 1.0:
-        return defaults
-    return dataclasses.replace(defaults, **{name: getattr(defaults, name) * k for name in METRE_SCALE_FIELDS})
+    scaled = {name: getattr(defaults, name) * k for name in METRE_SCALE_FIELDS} if k != 1.0 else {}
+    if leg_room_m < scaled.get("leg_spacing_ref_m", defaults.leg_spacing_ref_m):
+        scaled["leg_spacing_ref_m"] = float(leg_room_m)
+    return dataclasses.replace(defaults, **scaled) if scaled else defaults
 
 
 TRAJECTORY_WEIGHT_FIELDS = tuple("trajectory_" + t for t in TRAJECTORY_TERMS)

@@ -214,6 +214,27 @@ def leg_sides(hips_body: np.ndarray, rest_body: np.ndarray) -> np.ndarray:
     return np.sign(lateral) * (np.abs(lateral) > 1e-3 * rest_radius)
 
 
+def side_neighbours(rest_body: np.ndarray, hips_body: np.ndarray) -> list[tuple[int, int]]:
+    """The (front, rear) pairs of legs next to each other on one side of the body (:func:`leg_sides`),
+    ordered by their rest feet's forward coordinate; legs on the midline have none.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> rest = np.array([[0.02, 0.05], [-0.02, 0.05], [0.0, -0.05], [0.06, 0.05]])
+    >>> hips = np.array([[0.01, 0.0, 0.01], [-0.01, 0.0, 0.01], [0.0, 0.0, -0.01], [0.03, 0.0, 0.01]])
+    >>> side_neighbours(rest, hips)
+    [(3, 0), (0, 1)]
+    """
+    side = leg_sides(hips_body, rest_body)
+    pairs = []
+    for s in (-1.0, 1.0):
+        legs = np.flatnonzero(side == s)
+        legs = legs[np.argsort(-rest_body[legs, 0], kind="stable")]  # front to back
+        pairs += [(int(front), int(rear)) for front, rear in zip(legs[:-1], legs[1:])]
+    return pairs
+
+
 def territory_bounds(rest_body: np.ndarray, hips_body: np.ndarray) -> np.ndarray:
     """(L, 2) each leg's **territory**: the body-forward interval, at its rest foot's lateral
     coordinate, between the lines that halve the gaps to its same-side neighbours.
@@ -259,18 +280,14 @@ def territory_bounds(rest_body: np.ndarray, hips_body: np.ndarray) -> np.ndarray
     rest_body = np.asarray(rest_body, dtype=np.float64)
     hips_body = np.asarray(hips_body, dtype=np.float64)
     bounds = np.tile(np.array([-np.inf, np.inf]), (rest_body.shape[0], 1))
-    side = leg_sides(hips_body, rest_body)
-    for s in (-1.0, 1.0):
-        legs = np.flatnonzero(side == s)
-        legs = legs[np.argsort(-rest_body[legs, 0], kind="stable")]  # front to back
-        for front, rear in zip(legs[:-1], legs[1:]):
-            hip = 0.5 * (hips_body[front, [0, 2]] + hips_body[rear, [0, 2]])
-            foot = 0.5 * (rest_body[front] + rest_body[rear])
-            if abs(foot[1] - hip[1]) < 1e-12:
-                continue
-            # Sorted along the side, each leg has one neighbour ahead and one behind: one line per end.
-            for leg, end in ((front, 0), (rear, 1)):
-                bounds[leg, end] = hip[0] + (rest_body[leg, 1] - hip[1]) / (foot[1] - hip[1]) * (foot[0] - hip[0])
+    for front, rear in side_neighbours(rest_body, hips_body):
+        hip = 0.5 * (hips_body[front, [0, 2]] + hips_body[rear, [0, 2]])
+        foot = 0.5 * (rest_body[front] + rest_body[rear])
+        if abs(foot[1] - hip[1]) < 1e-12:
+            continue
+        # Sorted along the side, each leg has one neighbour ahead and one behind: one line per end.
+        for leg, end in ((front, 0), (rear, 1)):
+            bounds[leg, end] = hip[0] + (rest_body[leg, 1] - hip[1]) / (foot[1] - hip[1]) * (foot[0] - hip[0])
     return bounds
 
 
@@ -310,21 +327,130 @@ def territory_speed_cap(timing, leg_height: float, rest_body: np.ndarray, hips_b
     >>> territory_speed_cap(GaitTiming(), 0.025, rest, hips, windows, 0.5)   # below it: no cap
     inf
     """
-    from footfall.planner._timing import duty_factor, stride_length
-
     bounds = territory_bounds(rest_body, hips_body)
     if not np.isfinite(bounds).any() or not math.isfinite(fastest) or fastest <= 0.0:
         return math.inf
+    speeds = _speeds_up_to(fastest)
+    sweep, centre = steady_sweeps(timing, leg_height, rest_body, windows, speeds)
+    inside = ((centre + 0.5 * sweep <= bounds[:, 1]) & (centre - 0.5 * sweep >= bounds[:, 0])).all(axis=1)
+    return _fastest_kept(speeds, inside)
+
+
+def _speeds_up_to(fastest: float) -> np.ndarray:
+    """The speeds the caps try, slowest first: ``fastest`` times powers of ``1 -``
+    :data:`TERRITORY_SPEED_STEP`, down to a thousandth of it."""
     steps = int(math.ceil(math.log(1e-3) / math.log1p(-TERRITORY_SPEED_STEP)))
-    speeds = fastest * (1.0 - TERRITORY_SPEED_STEP) ** np.arange(steps)[::-1]  # slowest first
+    return fastest * (1.0 - TERRITORY_SPEED_STEP) ** np.arange(steps)[::-1]
+
+
+def _fastest_kept(speeds: np.ndarray, kept: np.ndarray) -> float:
+    """The speed below the slowest of ``speeds`` (slowest first) where ``kept`` first fails; ``inf`` when
+    it never fails, or already fails at the slowest (walking slower would not keep it)."""
+    if not kept[0] or kept.all():
+        return math.inf
+    return float(speeds[int(np.argmin(kept)) - 1])
+
+
+def steady_sweeps(timing, leg_height: float, rest_body: np.ndarray, windows: np.ndarray,
+                  speeds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(sweep (n, 1), centre (n, L)) m: at each of ``speeds`` (n,), the steady stance sweep of every leg,
+    ``min(DF(v) lambda(v), narrowest window)`` (the duty law, lowered to the duty ceiling), and its
+    body-forward centre as the requests centre it (:func:`stance_centres` in the leg's window). A stance
+    foot lands at ``centre + sweep / 2`` and lifts at ``centre - sweep / 2``."""
+    from footfall.planner._timing import duty_factor, stride_length
+
+    speeds = np.asarray(speeds, dtype=np.float64)
     narrowest = float(np.min(windows[:, 1] - windows[:, 0]))
     sweep = np.minimum(duty_factor(timing, speeds, leg_height) * stride_length(timing, speeds, leg_height),
                        narrowest)[:, None]
     centre = stance_centres(rest_body[:, 0], windows, np.broadcast_to(sweep, (speeds.size, rest_body.shape[0])))
-    inside = ((centre + 0.5 * sweep <= bounds[:, 1]) & (centre - 0.5 * sweep >= bounds[:, 0])).all(axis=1)
-    if not inside[0] or inside.all():
+    return sweep, centre
+
+
+def _segment_point_distance(px, pz, ax, az, bx, bz):
+    """Distance from points (px, pz) to segments a -> b (numpy, broadcast)."""
+    dx, dz = bx - ax, bz - az
+    length2 = dx * dx + dz * dz
+    t = np.clip(((px - ax) * dx + (pz - az) * dz) / np.where(length2 > 0.0, length2, 1.0), 0.0, 1.0)
+    return np.hypot(px - ax - t * dx, pz - az - t * dz)
+
+
+def neighbour_gaps(timing, leg_height: float, rest_body: np.ndarray, hips_body: np.ndarray, windows: np.ndarray,
+                   speeds, late_s: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """(feet (n,), legs (n,)) m: at each of ``speeds``, the least gap, over the legs next to each other on
+    a side (:func:`side_neighbours`), between the rear leg's steady landing spot and the front leg's
+    lift-off spot (``feet``), and between each of those spots and the other leg's straight line, hip to
+    spot (``legs``); ``inf`` without such legs. Spots at the rest feet's lateral coordinates
+    (:func:`steady_sweeps`).
+
+    In a wave gait the rear leg lands as its front neighbour is about to lift: at speed both stand at the
+    ends of their sweeps that face each other, and the search keeps a foot's room between feet and half of
+    it between a foot and a leg (``planner._kernels_foot.LEG_CLEARANCE``).
+
+    Examples
+    --------
+    Two legs on the left whose rest feet are 4 cm apart, their sweeps centred on them: at a standstill
+    the feet stand 4 cm apart; each centimetre of sweep brings the two ends facing each other 1 cm nearer.
+
+    >>> import numpy as np
+    >>> from footfall.planner._timing import GaitTiming, duty_factor, stride_length
+    >>> rest = np.array([[0.02, 0.05], [-0.02, 0.05]])
+    >>> hips = np.array([[0.01, 0.0, 0.01], [-0.01, 0.0, 0.01]])
+    >>> windows = rest[:, :1] + np.array([[-0.03, 0.03]])
+    >>> feet, legs = neighbour_gaps(GaitTiming(), 0.025, rest, hips, windows, [0.0, 0.3])
+    >>> sweep = float(duty_factor(GaitTiming(), 0.3, 0.025) * stride_length(GaitTiming(), 0.3, 0.025))
+    >>> feet.round(4).tolist(), round(0.04 - sweep, 4)
+    ([0.04, 0.015], 0.015)
+    """
+    speeds = np.atleast_1d(np.asarray(speeds, dtype=np.float64))
+    feet = np.full(speeds.size, np.inf)
+    legs = np.full(speeds.size, np.inf)
+    pairs = side_neighbours(rest_body, hips_body)
+    if not pairs:
+        return feet, legs
+    sweep, centre = steady_sweeps(timing, leg_height, rest_body, windows, speeds)
+    for front, rear in pairs:
+        lift_x, lift_z = centre[:, front] - 0.5 * sweep[:, 0] - speeds * late_s, rest_body[front, 1]
+        land_x, land_z = centre[:, rear] + 0.5 * sweep[:, 0], rest_body[rear, 1]
+        feet = np.minimum(feet, np.hypot(lift_x - land_x, lift_z - land_z))
+        (fx, _, fz), (rx, _, rz) = hips_body[front], hips_body[rear]
+        legs = np.minimum(legs, np.minimum(_segment_point_distance(land_x, land_z, fx, fz, lift_x, lift_z),
+                                           _segment_point_distance(lift_x, lift_z, rx, rz, land_x, land_z)))
+    return feet, legs
+
+
+def neighbour_speed_cap(timing, leg_height: float, rest_body: np.ndarray, hips_body: np.ndarray,
+                        windows: np.ndarray, fastest: float, foot_room: float, late_s: float = 0.0) -> float:
+    """The fastest speed (m/s, at most ``fastest``) at which the steady landing and lift-off spots of
+    legs next to each other keep the search's rooms (:func:`neighbour_gaps`): ``foot_room`` between the
+    feet, ``LEG_CLEARANCE`` of it between a foot and the other leg; ``inf`` when they keep them up to
+    ``fastest``, or keep them at no speed tried (:func:`territory_speed_cap`'s speeds).
+
+    Past it, the rear leg's landing spot is refused or scored down beside its neighbour's foot, and the
+    foot lands a cell short of the stride law: random creatures whose rest feet were 4 cm apart, walked at
+    their territory cap, landed their rear feet 1.3-2.9 cm short of 5 cm strides (per-stride p90 0.28-0.69).
+
+    Examples
+    --------
+    :func:`neighbour_gaps`' legs with a 1 cm foot room: the ends facing each other come within a room once
+    the sweeps reach 3 cm (0.04 - 0.03 = 0.01 m).
+
+    >>> import numpy as np
+    >>> from footfall.planner._timing import GaitTiming, duty_factor, stride_length
+    >>> rest = np.array([[0.02, 0.05], [-0.02, 0.05]])
+    >>> hips = np.array([[0.01, 0.0, 0.01], [-0.01, 0.0, 0.01]])
+    >>> windows = rest[:, :1] + np.array([[-0.03, 0.03]])
+    >>> v = neighbour_speed_cap(GaitTiming(), 0.025, rest, hips, windows, 1.0, 0.01)
+    >>> round(v, 3), round(float(duty_factor(GaitTiming(), v, 0.025) * stride_length(GaitTiming(), v, 0.025)), 4)
+    (0.531, 0.03)
+    """
+    from footfall.planner._kernels_foot import LEG_CLEARANCE
+
+    if not side_neighbours(rest_body, hips_body) or not math.isfinite(fastest) or fastest <= 0.0:
         return math.inf
-    return float(speeds[int(np.argmin(inside)) - 1])
+    speeds = _speeds_up_to(fastest)
+    feet, legs = neighbour_gaps(timing, leg_height, rest_body, hips_body, windows, speeds, late_s)
+    return _fastest_kept(speeds, (feet >= foot_room) & (legs >= LEG_CLEARANCE * foot_room))
 
 
 MIN_CYCLE_FRAMES = 4
@@ -363,30 +489,64 @@ def frame_rate_cap(timing, leg_height: float, dt: float, min_cycle_frames: float
     return (f_max * c * leg_height * (GRAVITY * leg_height) ** (-e)) ** (1.0 / (1.0 - 2.0 * e))
 
 
+def leg_room(timing, leg_height: float, rest_body: np.ndarray, hips_body: np.ndarray, windows: np.ndarray,
+             speed: float, foot_room: float, late_s: float = 0.0) -> float:
+    """m: the room between neighbouring legs a footprint can be asked for at ``speed``
+    (``planner.default_weights``' ``leg_room_m``): what the stride law's own landing spots leave
+    (:func:`neighbour_gaps`' ``legs``, a front foot lifting up to ``late_s`` late), and at least
+    ``foot_room``; ``inf`` without legs next to each other.
+
+    At least a foot's room: asked for less (the half of it the search keeps at the least), dense
+    creatures' feet landed where their legs were drawn across each other at the next turn (random
+    creatures, 48 runs: crossing frames 91 -> 239).
+
+    Examples
+    --------
+    :func:`neighbour_gaps`' legs walked at 0.3 m/s: the spots facing each other 1.5 cm apart, each
+    further from the other leg's line; with 2 cm feet, a foot's room.
+
+    >>> import numpy as np
+    >>> from footfall.planner._timing import GaitTiming
+    >>> rest = np.array([[0.02, 0.05], [-0.02, 0.05]])
+    >>> hips = np.array([[0.01, 0.0, 0.01], [-0.01, 0.0, 0.01]])
+    >>> windows = rest[:, :1] + np.array([[-0.03, 0.03]])
+    >>> round(leg_room(GaitTiming(), 0.025, rest, hips, windows, 0.3, 0.01), 4)
+    0.015
+    >>> leg_room(GaitTiming(), 0.025, rest, hips, windows, 0.3, 0.02)
+    0.02
+    """
+    _, legs = neighbour_gaps(timing, leg_height, rest_body, hips_body, windows, [speed], late_s)
+    return max(float(legs[0]), foot_room)
+
+
 def speed_caps(timing, leg_height: float, rest_body: np.ndarray, hips_body: np.ndarray, windows: np.ndarray,
-               dt: float) -> dict:
+               dt: float, foot_room: float = 0.0) -> dict:
     """The speeds (m/s) past which the legs cannot carry the stride law, by what sets each:
     ``"windows"`` (:func:`speed_cap` of the narrowest stance window), ``"frames"``
-    (:func:`frame_rate_cap`) and ``"territories"`` (:func:`territory_speed_cap` below the other two).
-    The crowd walks no faster than the least of them (``init_crowd``; ``CrowdModel.speed_cap`` and
+    (:func:`frame_rate_cap`), ``"territories"`` (:func:`territory_speed_cap` below the other two) and
+    ``"neighbours"`` (:func:`neighbour_speed_cap` with ``foot_room`` (m), below the other three). The crowd
+    walks no faster than the least of them (``init_crowd``; ``CrowdModel.speed_cap`` and
     ``speed_cap_reason``).
 
     Examples
     --------
     The legs of :func:`territory_speed_cap`'s example four times as large (10 cm high), drawn at 30
-    frames a second: their sweeps reach each other's territories first.
+    frames a second: their sweeps reach each other's territories first; with 4 cm feet, their landing and
+    lift-off spots come within a foot's room of each other sooner still.
 
     >>> import numpy as np
     >>> from footfall.planner._timing import GaitTiming
     >>> rest = np.array([[0.08, 0.2], [-0.08, 0.2]])
     >>> hips = np.array([[0.04, 0.0, 0.04], [-0.04, 0.0, 0.04]])
-    >>> caps = speed_caps(GaitTiming(), 0.1, rest, hips, rest[:, :1] + np.array([[-0.12, 0.12]]), 1 / 30)
+    >>> caps = speed_caps(GaitTiming(), 0.1, rest, hips, rest[:, :1] + np.array([[-0.12, 0.12]]), 1 / 30, 0.04)
     >>> {name: round(v, 2) for name, v in caps.items()}
-    {'windows': 3.38, 'frames': 3.96, 'territories': 1.7}
+    {'windows': 3.38, 'frames': 3.96, 'territories': 1.7, 'neighbours': 1.06}
     """
     caps = {"windows": speed_cap(timing, leg_height, float(np.min(windows[:, 1] - windows[:, 0]))),
             "frames": frame_rate_cap(timing, leg_height, dt)}
     caps["territories"] = territory_speed_cap(timing, leg_height, rest_body, hips_body, windows, min(caps.values()))
+    caps["neighbours"] = neighbour_speed_cap(timing, leg_height, rest_body, hips_body, windows, min(caps.values()),
+                                             foot_room)
     return caps
 
 

@@ -35,7 +35,8 @@ def say_speed_cap(model) -> None:
     if model.speed_asked > model.speed_cap:
         why = {"windows": "its stance sweeps fit its legs' stance windows",
                "frames": f"a stride cycle lasts at least {MIN_CYCLE_FRAMES} frames",
-               "territories": "each stance sweep keeps to its leg's territory, clear of the neighbouring legs"}
+               "territories": "each stance sweep keeps to its leg's territory, clear of the neighbouring legs",
+               "neighbours": "each foot lands a foot's room clear of the neighbouring leg's foot"}
         print(f"footfall: note: {model.creature.name}: {model.speed_asked:g} m/s asked; speed capped at "
               f"{model.speed_cap:.3g} m/s, the fastest its legs carry at the stride law where "
               f"{why[model.speed_cap_reason]}", file=sys.stderr)

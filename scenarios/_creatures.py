@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -202,6 +203,12 @@ class Creature:
         directions = np.tile([1.0, 0.0], (self.n_legs, 1))
         directions[safe] = offsets[safe] / norms[safe]
         return readonly(directions)
+
+    @property
+    def foot_room(self) -> float:
+        """Room (m) a planned foot keeps from every other foot: the foot's diagonal (the footprint
+        search's ``block_radius``, the disc the foot covers in any yaw, doubled)."""
+        return math.hypot(self.foot_length, self.foot_width)
 
     @property
     def rest_radius(self) -> float:

@@ -415,7 +415,6 @@ def test_a_crowd_spawns_with_every_foot_a_foots_room_from_the_other_characters_f
     """64 spiders spawned on ``mixed``: neighbours' legs interleave, and rest feet of two characters
     used to start on one spot (17 shared foot spots over the first frames, until they stepped). A rest
     foot within a foot's room of another character's moves straight away from it."""
-    from footfall.planner._crowd import _foot_room
 
     scenario, creature = load_scenario("mixed"), load_creature("spider")
     model, state = init_crowd(scenario, creature, load_gait(default_gait_name("spider"), creature),
@@ -424,7 +423,7 @@ def test_a_crowd_spawns_with_every_foot_a_foots_room_from_the_other_characters_f
     owner = np.repeat(np.arange(64), creature.n_legs)
     d = np.hypot(feet[:, None, 0] - feet[None, :, 0], feet[:, None, 1] - feet[None, :, 1])
     other = owner[:, None] != owner[None, :]
-    assert d[other].min() >= _foot_room(model) - 1e-9
+    assert d[other].min() >= model.creature.foot_room - 1e-9
     # ... and every leg still reaches its moved rest foot.
     assert simulate(model, state, 1).max_stance_slip_m <= 1e-3
 
@@ -458,12 +457,12 @@ def test_two_feet_planned_in_one_frame_never_share_a_spot_whether_of_one_charact
     rear legs landed on one spot and their legs crossed)."""
     import dataclasses
 
-    from footfall.planner._crowd import _foot_room, _same_frame_conflicts
+    from footfall.planner._crowd import _same_frame_conflicts
 
     scenario, creature = load_scenario("flat"), load_creature("spider")
     model, _ = init_crowd(scenario, creature, load_gait(default_gait_name("spider"), creature), n_characters=2,
                           seed=0, lod_mode="off", raster=_raster(scenario, creature))
-    room = _foot_room(model)
+    room = model.creature.foot_room
     # plans: 0 and 1 are character 0's, 2 is character 1's, 3 is character 0's again but far away.
     cs = np.array([0, 0, 1, 0])
     targets = np.array([[0.0, 0.0, 0.0], [0.5 * room, 0.0, 0.0], [0.0, 0.0, 0.9 * room], [1.0, 0.0, 1.0]])

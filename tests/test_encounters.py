@@ -1113,7 +1113,7 @@ def test_a_foot_a_shove_carries_onto_another_characters_foot_plans_again():
     # search's block radius) of that target, that foot, and no other, plans again (kind 3, landing or
     # not); just outside it, or with ant 0 not shoved, it lands as planned (kind 0).
     from footfall.planner import _crowd as crowd
-    from footfall.planner._crowd import _foot_room, stage_requests
+    from footfall.planner._crowd import stage_requests
 
     model, state = _ants_walked_a_second(2)
     air = np.flatnonzero(~state.in_stance[0])
@@ -1129,7 +1129,7 @@ def test_a_foot_a_shove_carries_onto_another_characters_foot_plans_again():
         crowd._landings_shoved_onto_feet(model, state)
         return stage_requests(model, state, *args)[0, air]
 
-    room = _foot_room(model)
+    room = model.creature.foot_room
     expected = np.where(air == a, 3, 0)
     np.testing.assert_array_equal(kinds_after(True, room - 0.001), expected)
     assert state.shoved_onto_feet.sum() == 1

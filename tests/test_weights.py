@@ -43,6 +43,22 @@ def test_default_weights_size_the_metre_scales_to_a_smaller_creature():
             default_weights(bad)
 
 
+def test_the_leg_spacing_reference_is_at_most_the_room_the_stride_law_leaves():
+    """default_weights(r, leg_room_m): the leg-spacing reference is min(its size-scaled value,
+    leg_room_m), every other field as without it; a bad room is refused naming the argument."""
+    from footfall.planner import REFERENCE_REST_RADIUS_M, default_weights
+
+    half = default_weights(0.5 * REFERENCE_REST_RADIUS_M)  # reference 0.025 m
+    tight = default_weights(0.5 * REFERENCE_REST_RADIUS_M, 0.01)
+    assert tight.leg_spacing_ref_m == 0.01
+    assert dataclasses.replace(tight, leg_spacing_ref_m=0.025) == half
+    assert default_weights(0.5 * REFERENCE_REST_RADIUS_M, 0.03) == half  # more room than asked: unchanged
+    assert default_weights(REFERENCE_REST_RADIUS_M, 0.02).leg_spacing_ref_m == 0.02
+    for bad in (0.0, -0.01, float("nan"), "0.02", True):
+        with pytest.raises(ValueError, match="leg_room_m"):
+            default_weights(REFERENCE_REST_RADIUS_M, bad)
+
+
 def test_weights_are_frozen():
     with pytest.raises(dataclasses.FrozenInstanceError):
         ScoringWeights().footprint_distance = 2.0
