@@ -2888,8 +2888,9 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
     seed : int, optional
         Seeds the gait phases and, with ``crowd.heading_mode = "random"``, the headings.
     weights : ScoringWeights, optional
-        Default ``default_weights(creature.rest_radius)`` (:func:`planner.default_weights`: the
-        reference scales sized to the creature).
+        Default ``default_weights(creature.rest_radius, leg_room)`` (:func:`planner.default_weights`:
+        the reference scales sized to the creature, the leg-spacing one no more than the room its stride
+        law leaves between neighbouring legs at the crowd's speed, ``planner._workspace.leg_room``).
     timing : GaitTiming, optional
         Default ``GaitTiming()``.
     lod_mode : {"off", "on", "zoomed"}, optional

@@ -381,7 +381,8 @@ def neighbour_gaps(timing, leg_height: float, rest_body: np.ndarray, hips_body: 
     a side (:func:`side_neighbours`), between the rear leg's steady landing spot and the front leg's
     lift-off spot (``feet``), and between each of those spots and the other leg's straight line, hip to
     spot (``legs``); ``inf`` without such legs. Spots at the rest feet's lateral coordinates
-    (:func:`steady_sweeps`).
+    (:func:`steady_sweeps`); a front foot lifting ``late_s`` seconds late stands ``speed * late_s``
+    further back.
 
     In a wave gait the rear leg lands as its front neighbour is about to lift: at speed both stand at the
     ends of their sweeps that face each other, and the search keeps a foot's room between feet and half of
@@ -420,7 +421,7 @@ def neighbour_gaps(timing, leg_height: float, rest_body: np.ndarray, hips_body: 
 
 
 def neighbour_speed_cap(timing, leg_height: float, rest_body: np.ndarray, hips_body: np.ndarray,
-                        windows: np.ndarray, fastest: float, foot_room: float, late_s: float = 0.0) -> float:
+                        windows: np.ndarray, fastest: float, foot_room: float) -> float:
     """The fastest speed (m/s, at most ``fastest``) at which the steady landing and lift-off spots of
     legs next to each other keep the search's rooms (:func:`neighbour_gaps`): ``foot_room`` between the
     feet, ``LEG_CLEARANCE`` of it between a foot and the other leg; ``inf`` when they keep them up to
@@ -429,6 +430,8 @@ def neighbour_speed_cap(timing, leg_height: float, rest_body: np.ndarray, hips_b
     Past it, the rear leg's landing spot is refused or scored down beside its neighbour's foot, and the
     foot lands a cell short of the stride law: random creatures whose rest feet were 4 cm apart, walked at
     their territory cap, landed their rear feet 1.3-2.9 cm short of 5 cm strides (per-stride p90 0.28-0.69).
+    The steady spots only: a front foot lifting a frame late stands nearer still, but capping for it put
+    the spider's cap (0.63 m/s) under its Fr 0.5 top speed (:func:`leg_room` allows for it instead).
 
     Examples
     --------
@@ -449,7 +452,7 @@ def neighbour_speed_cap(timing, leg_height: float, rest_body: np.ndarray, hips_b
     if not side_neighbours(rest_body, hips_body) or not math.isfinite(fastest) or fastest <= 0.0:
         return math.inf
     speeds = _speeds_up_to(fastest)
-    feet, legs = neighbour_gaps(timing, leg_height, rest_body, hips_body, windows, speeds, late_s)
+    feet, legs = neighbour_gaps(timing, leg_height, rest_body, hips_body, windows, speeds)
     return _fastest_kept(speeds, (feet >= foot_room) & (legs >= LEG_CLEARANCE * foot_room))
 
 
