@@ -167,6 +167,7 @@ def check_cmd(
     if creature is not None and kind != "gait":
         raise InputError("argument", "--creature", f"only a gait is checked against a creature; {file} is a {kind}")
     notes: list[str] = []
+    warnings: list[str] = []
     if kind == "scenario":
         s = load_scenario(file)
         c = load_creature(s.crowd.creature)
@@ -183,6 +184,8 @@ def check_cmd(
         line = (f"{file}: ok: creature {c.name}, {c.n_legs} legs x {c.n_segments} segments, reach "
                 f"{c.max_reach:.3g} m, rest radius {c.rest_radius:.3g} m ({scoring_scales_note(c.rest_radius)}); "
                 f"default gait {g.name}: {g.description}")
+        kind_of_note, text = speed_cap_note(c)
+        (warnings if kind_of_note == "warning" else notes).append(text)
     else:
         if creature is None:
             raise InputError("argument", "--creature", f"a gait is checked against a creature: footfall check {file} "
@@ -198,6 +201,8 @@ def check_cmd(
     err = _err()
     for message in leg_crossing_warnings(c):
         err.print(f"footfall: warning: {where}: {c.name}: {message}", markup=False, soft_wrap=True)
+    for message in warnings:
+        err.print(f"footfall: warning: {where}: {message}", markup=False, soft_wrap=True)
     for note in filter(None, notes):
         err.print(f"footfall: note: {note}", markup=False, soft_wrap=True)
 
@@ -850,6 +855,30 @@ def matrix_table(matrix: dict) -> Table:
             row.append(text)
         table.add_row(name, *row, "yes" if p["passes"] else "no: " + p["why"][0][:120])
     return table
+
+
+def speed_cap_note(creature) -> tuple[str, str]:
+    """("note" or "warning", text): the fastest the creature's legs carry at the stride law (the default
+    one, its own rest feet) and what sets it (``planner._workspace.speed_caps``, as ``init_crowd`` caps
+    a crowd); a warning naming the legs when they carry no stance at all (the creature cannot walk):
+    what ``footfall check`` says of a creature file."""
+    import numpy as np
+
+    from footfall.planner._crowd import DT
+    from footfall.planner._ik import legs_of
+    from footfall.planner._timing import GaitTiming, hip_height
+    from footfall.planner._workspace import SPEED_CAP_REASONS, speed_caps, stance_windows
+
+    rest, hips = np.asarray(creature.rest_feet, dtype=np.float64), np.asarray(creature.hips, dtype=np.float64)
+    windows = stance_windows(creature, rest, hips, legs_of(creature))
+    caps = speed_caps(GaitTiming(), hip_height(creature), rest, hips, windows, DT, creature.foot_room)
+    reason = min(caps, key=caps.get)
+    if caps[reason] <= 0.0:
+        stuck = [creature.leg_names[i] for i in np.flatnonzero(windows[:, 1] - windows[:, 0] <= 1e-9)]
+        return "warning", (f"{creature.name} cannot walk: legs {', '.join(stuck)} carry no stance at its standing "
+                           f"height (their stance windows are empty); it stands where it spawns")
+    return "note", (f"{creature.name} walks at most {caps[reason]:.3g} m/s, the fastest its legs carry at the "
+                    f"stride law where {SPEED_CAP_REASONS[reason]}")
 
 
 def scoring_scales_note(rest_radius: float) -> str:

@@ -522,6 +522,16 @@ def leg_room(timing, leg_height: float, rest_body: np.ndarray, hips_body: np.nda
     return max(float(legs[0]), foot_room)
 
 
+SPEED_CAP_REASONS = {
+    "windows": "its stance sweeps fit its legs' stance windows",
+    "frames": f"a stride cycle lasts at least {MIN_CYCLE_FRAMES} frames",
+    "territories": "each stance sweep keeps to its leg's territory, clear of the neighbouring legs",
+    "neighbours": "each foot lands a foot's room clear of the neighbouring leg's foot",
+}
+"""What sets each of :func:`speed_caps`' caps, said where a creature is capped (``footfall check``, the
+runs' stderr note): "the fastest its legs carry at the stride law where ..."."""
+
+
 def speed_caps(timing, leg_height: float, rest_body: np.ndarray, hips_body: np.ndarray, windows: np.ndarray,
                dt: float, foot_room: float = 0.0) -> dict:
     """The speeds (m/s) past which the legs cannot carry the stride law, by what sets each:

@@ -30,16 +30,12 @@ def say_speed_cap(model) -> None:
     """One note on stderr when the creature's legs cannot carry the asked speed (the controller caps it)."""
     import sys
 
-    from footfall.planner._workspace import MIN_CYCLE_FRAMES
+    from footfall.planner._workspace import SPEED_CAP_REASONS
 
     if model.speed_asked > model.speed_cap:
-        why = {"windows": "its stance sweeps fit its legs' stance windows",
-               "frames": f"a stride cycle lasts at least {MIN_CYCLE_FRAMES} frames",
-               "territories": "each stance sweep keeps to its leg's territory, clear of the neighbouring legs",
-               "neighbours": "each foot lands a foot's room clear of the neighbouring leg's foot"}
         print(f"footfall: note: {model.creature.name}: {model.speed_asked:g} m/s asked; speed capped at "
               f"{model.speed_cap:.3g} m/s, the fastest its legs carry at the stride law where "
-              f"{why[model.speed_cap_reason]}", file=sys.stderr)
+              f"{SPEED_CAP_REASONS[model.speed_cap_reason]}", file=sys.stderr)
 
 
 def recording_meta(scenario, seed: int, lod: str, gait, navigate: bool = True) -> dict:

@@ -26,6 +26,76 @@ def test_check_says_how_the_scoring_scales_fit_a_creature():
     assert done.returncode == 0 and "(the scoring's metre scales the spider's)" in done.stdout, done.stdout
 
 
+def test_check_says_how_fast_a_creature_walks_and_what_caps_it():
+    # A user who writes a dense creature learns before running it that it walks slowly, and why: the
+    # cap init_crowd gives a crowd of it (planner._workspace.speed_caps).
+    from pathlib import Path
+
+    from footfall.planner import init_crowd
+    from footfall.scenarios import load_creature, load_scenario
+    from footfall.scenarios._gait_choice import resolve_gait
+
+    splay8 = Path(__file__).parent / "data" / "creatures" / "splay8.toml"
+    done = footfall_cli("check", str(splay8))
+    assert done.returncode == 0, done.stderr
+    creature = load_creature(str(splay8))
+    model, _ = init_crowd(load_scenario("flat"), creature, resolve_gait(None, creature)[0], n_characters=1)
+    assert (f"splay8 walks at most {model.speed_cap:.3g} m/s, the fastest its legs carry at the stride law where "
+            "each foot lands a foot's room clear of the neighbouring leg's foot") in done.stderr
+    done = footfall_cli("check", "robot5")
+    assert "robot5 walks at most 2.06 m/s" in done.stderr and "stance windows" in done.stderr, done.stderr
+
+
+STANDS_STILL = """name = "rc4"
+description = "Random creature rc4 of tests/random_creatures.py 31 8: long hind shins, hips 9 mm high."
+standing_height = 0.0087
+body_thickness = 0.0044
+body_box = [0.0480, 0.0222]
+foot = { length = 0.0033, width = 0.0025 }
+
+[leg_defaults]
+joint_limits = [[-1.2, 0.8], [0.0, 2.4]]
+
+[[legs]]
+name = "L1"
+hip = [0.0108, 0.0, 0.0100]
+rest_foot = [0.0173, 0.0355]
+segments = [0.0185, 0.0156]
+
+[[legs]]
+name = "R1"
+hip = [0.0108, 0.0, -0.0100]
+rest_foot = [0.0173, -0.0355]
+segments = [0.0185, 0.0156]
+
+[[legs]]
+name = "L2"
+hip = [-0.0108, 0.0, 0.0100]
+rest_foot = [-0.0204, 0.0462]
+segments = [0.0168, 0.0410]
+
+[[legs]]
+name = "R2"
+hip = [-0.0108, 0.0, -0.0100]
+rest_foot = [-0.0204, -0.0462]
+segments = [0.0168, 0.0410]
+
+"""
+
+
+def test_check_warns_of_a_creature_that_cannot_walk(tmp_path):
+    # A random creature (tests/random_creatures.py 31 8, rc4): its hind legs reach their rest feet and no
+    # further at its standing height, so their stance windows are empty and its speed is capped at 0: in
+    # every run of footfall evaluate it stood where it spawned. footfall check says so, naming the legs.
+    path = tmp_path / "rc4.toml"
+    path.write_text(STANDS_STILL)
+    done = footfall_cli("check", str(path))
+    assert done.returncode == 0, done.stderr
+    assert (f"footfall: warning: {path}: rc4 cannot walk: legs L2, R2 carry no stance at its standing height"
+            in done.stderr), done.stderr
+    assert "walks at most" not in done.stderr
+
+
 @pytest.mark.parametrize(
     "content, field",
     [
