@@ -18,6 +18,7 @@ import io
 import math
 import secrets
 import shlex
+import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -107,7 +108,7 @@ def replay_command(run: dict) -> str:
 def run_one(task: dict) -> dict:
     """One run (a task of :func:`footfall._distribute.run_tasks`): its summary and violations; with
     ``task['picture']``, also the pelvis paths and footprints for a picture."""
-    from footfall.reports._runs import recorded_run
+    from footfall.reports._runs import recorded_run, speed_cap_message
     from footfall.scenarios._gait_choice import resolve_gait
     from footfall.scenarios import load_creature, load_scenario
 
@@ -124,11 +125,12 @@ def run_one(task: dict) -> dict:
         preset = Preset(creature.name, ScoringWeights.from_array(task["weights"]), timing, None, {})
     model, summary, recorder = recorded_run(scenario, creature, gait, frames=task["frames"],
                                             characters=task["characters"], seed=task["seed"], lod=task["lod"],
-                                            navigate=navigate, record=bool(task.get("picture")), preset=preset)
+                                            navigate=navigate, record=bool(task.get("picture")), preset=preset,
+                                            say_cap=False)
     s = summary.to_json()
     out = {**{k: task[k] for k in ("scenario", "creature", "seed", "characters", "frames", "lod")},
            "navigate": navigate, **{k: task.get(k) for k in ("preset", "weights", "timing")},
-           "summary": s, "violations": violations(s, task["scenario"])}
+           "summary": s, "violations": violations(s, task["scenario"]), "speed_cap_note": speed_cap_message(model)}
     if recorder is not None:
         a = recorder.arrays
         landed = a["in_stance"][1:] & ~a["in_stance"][:-1]
@@ -166,6 +168,9 @@ def evaluate(scenarios, creatures, seeds: list[int], *, characters: int, frames:
               "lod": lod, "navigate": navigate, **numbers}
              for sc in scenarios for cr in creatures for seed in seeds]
     runs = run_tasks(run_one, tasks, workers=workers, cluster=cluster, progress=progress)
+    # Each creature's speed cap said once (its runs say the same: a note per run was 18 lines a creature).
+    for note in dict.fromkeys(run["speed_cap_note"] for run in runs if run.get("speed_cap_note")):
+        print(note, file=sys.stderr)
     totals = {name: 0 for name in PROMISE_NAMES}
     failed = []
     for run in runs:

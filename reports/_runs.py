@@ -7,11 +7,14 @@ from pathlib import Path
 
 
 def recorded_run(scenario, creature, gait, *, frames: int, characters: int | None = None, seed: int = 0,
-                 preset=None, lod: str = "off", record: bool = True, progress=None, navigate: bool = True):
+                 preset=None, lod: str = "off", record: bool = True, progress=None, navigate: bool = True,
+                 say_cap: bool = True):
     """Simulate ``frames`` frames of the scenario's crowd; returns (model, summary, recorder or None).
 
     ``preset``: a loaded :class:`planner.Preset` (its weights and timing), or None for the defaults.
-    ``progress(k)`` is called after frame k. ``navigate``: ``ControllerConfig.navigate``.
+    ``progress(k)`` is called after frame k. ``navigate``: ``ControllerConfig.navigate``. ``say_cap``:
+    say on stderr when the creature's speed is capped (:func:`say_speed_cap`; a sweep of many runs says
+    it once, from :func:`speed_cap_message`).
     """
     from footfall.planner._crowd import ControllerConfig, init_crowd
     from footfall.planner._simulation import Recorder, simulate
@@ -21,21 +24,31 @@ def recorded_run(scenario, creature, gait, *, frames: int, characters: int | Non
     model, state = init_crowd(scenario, creature, gait, n_characters=characters, seed=seed, weights=weights,
                               timing=timing, lod_mode=lod, controller=ControllerConfig(navigate=navigate))
     recorder = Recorder(model, state, frames) if record else None
-    say_speed_cap(model)
+    if say_cap:
+        say_speed_cap(model)
     summary = simulate(model, state, frames, recorder, progress=progress)
     return model, summary, recorder
 
 
-def say_speed_cap(model) -> None:
-    """One note on stderr when the creature's legs cannot carry the asked speed (the controller caps it)."""
-    import sys
-
+def speed_cap_message(model) -> str | None:
+    """The note a run says when the creature's legs cannot carry the asked speed (the controller caps it),
+    or None."""
     from footfall.planner._workspace import SPEED_CAP_REASONS
 
-    if model.speed_asked > model.speed_cap:
-        print(f"footfall: note: {model.creature.name}: {model.speed_asked:g} m/s asked; speed capped at "
-              f"{model.speed_cap:.3g} m/s, the fastest its legs carry at the stride law where "
-              f"{SPEED_CAP_REASONS[model.speed_cap_reason]}", file=sys.stderr)
+    if model.speed_asked <= model.speed_cap:
+        return None
+    return (f"footfall: note: {model.creature.name}: {model.speed_asked:g} m/s asked; speed capped at "
+            f"{model.speed_cap:.3g} m/s, the fastest its legs carry at the stride law where "
+            f"{SPEED_CAP_REASONS[model.speed_cap_reason]}")
+
+
+def say_speed_cap(model) -> None:
+    """:func:`speed_cap_message` on stderr, if any."""
+    import sys
+
+    message = speed_cap_message(model)
+    if message is not None:
+        print(message, file=sys.stderr)
 
 
 def recording_meta(scenario, seed: int, lod: str, gait, navigate: bool = True) -> dict:
