@@ -864,15 +864,11 @@ def speed_cap_note(creature) -> tuple[str, str]:
     what ``footfall check`` says of a creature file."""
     import numpy as np
 
-    from footfall.planner._crowd import DT
-    from footfall.planner._ik import legs_of
-    from footfall.planner._timing import GaitTiming, hip_height
-    from footfall.planner._workspace import SPEED_CAP_REASONS, speed_caps, stance_windows
+    from footfall.planner import GaitTiming, creature_walk
+    from footfall.planner._workspace import SPEED_CAP_REASONS
 
-    rest, hips = np.asarray(creature.rest_feet, dtype=np.float64), np.asarray(creature.hips, dtype=np.float64)
-    windows = stance_windows(creature, rest, hips, legs_of(creature))
-    caps = speed_caps(GaitTiming(), hip_height(creature), rest, hips, windows, DT, creature.foot_room)
-    reason = min(caps, key=caps.get)
+    walk = creature_walk(creature, GaitTiming(), 0.0)  # its caps, whatever speed is asked
+    caps, reason, windows = walk.caps, walk.cap_reason, walk.window
     if caps[reason] <= 0.0:
         stuck = [creature.leg_names[i] for i in np.flatnonzero(windows[:, 1] - windows[:, 0] <= 1e-9)]
         return "warning", (f"{creature.name} cannot walk: legs {', '.join(stuck)} carry no stance at its standing "

@@ -19,10 +19,12 @@ _keep_freed_memory()
 from footfall.planner._batch import BatchResult, FootBatch, make_batch, plan_batch  # noqa: E402
 from footfall.planner._crowd import (  # noqa: E402
     ControllerConfig,
+    CreatureWalk,
     CrowdModel,
     CrowdState,
     FramePlans,
     StepRecord,
+    creature_walk,
     init_crowd,
     planner_config_for,
     step,
@@ -119,6 +121,8 @@ __all__ = [
     "body_rotation",
     "ControllerConfig",
     "CoupleResult",
+    "CreatureWalk",
+    "creature_walk",
     "CrowdModel",
     "CrowdState",
     "default_weights",

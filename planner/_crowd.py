@@ -2860,6 +2860,103 @@ def planner_config_for(creature) -> PlannerConfig:
     return config if cells <= config.map_cells else dataclasses.replace(config, map_cells=cells)
 
 
+@dataclass(frozen=True)
+class CreatureWalk:
+    """What a creature's legs allow at the stride law, with its rest feet spaced by a scenario's
+    ``feet_spacing`` and asked a speed (:func:`creature_walk`): what ``init_crowd`` builds a crowd with,
+    ``footfall check`` says of a creature and ``tuning.creature_defaults`` starts from, computed once.
+
+    Attributes
+    ----------
+    rest_body, hips_body : ndarray
+        Rest feet (L, 2) and hips (L, 3), body frame, m.
+    leg_static : object
+        The legs' IK statics (``planner._ik.legs_of``).
+    window : ndarray, shape (L, 2)
+        Each leg's stance window (``planner._workspace.stance_windows``).
+    caps : dict
+        ``planner._workspace.speed_caps``: m/s by what sets each.
+    cap_reason : str
+        The least of them, ``cap`` its speed (m/s).
+    speed : float
+        The speed walked: the asked one, at most ``cap``.
+    weights : ScoringWeights
+        The default scoring weights (:func:`planner.default_weights` at the creature's rest radius and the
+        leg room its law leaves at ``speed``, ``planner._workspace.leg_room``).
+
+    Examples
+    --------
+    >>> from footfall.planner import GaitTiming, creature_walk
+    >>> from footfall.scenarios import load_creature
+    >>> walk = creature_walk(load_creature("ant"), GaitTiming(), 0.3)
+    >>> walk.window.shape, walk.cap_reason   # an ant's cycle would last under 4 frames first
+    ((6, 2), 'frames')
+    """
+
+    rest_body: np.ndarray
+    hips_body: np.ndarray
+    leg_static: object
+    window: np.ndarray
+    caps: dict
+    cap_reason: str
+    cap: float
+    speed: float
+    weights: ScoringWeights
+
+
+def creature_walk(creature, timing, speed_asked: float, feet_spacing: float = 1.0) -> CreatureWalk:
+    """The :class:`CreatureWalk` of ``creature``: what its legs allow at the stride law; no world is needed.
+
+    Parameters
+    ----------
+    creature : scenarios.Creature
+        The creature.
+    timing : GaitTiming
+        Its stride law and duty law.
+    speed_asked : float
+        The speed asked (m/s); walked at most at the cap.
+    feet_spacing : float, optional
+        The scenario's factor on the rest feet (default 1).
+
+    Returns
+    -------
+    CreatureWalk
+
+    Examples
+    --------
+    >>> from footfall.planner import ScoringWeights
+    >>> from footfall.planner._timing import GaitTiming
+    >>> from footfall.scenarios import load_creature
+    >>> walk = creature_walk(load_creature("spider"), GaitTiming(), 0.3)
+    >>> walk.cap_reason, round(walk.cap, 3), walk.speed   # its feet keep clear of each other up to 0.9 m/s
+    ('neighbours', 0.898, 0.3)
+    >>> walk.weights == ScoringWeights()                   # the room its law leaves is more than it asks
+    True
+    """
+    from footfall.planner._ik import legs_of
+    from footfall.planner._timing import hip_height
+    from footfall.planner._workspace import leg_room, speed_caps, stance_windows
+
+    hips_body = np.asarray(creature.hips, dtype=np.float64)
+    rest_body = float(feet_spacing) * np.asarray(creature.rest_feet, dtype=np.float64)
+    leg_static = legs_of(creature)
+    window = stance_windows(creature, rest_body, hips_body, leg_static)
+    h = hip_height(creature)
+    # Past this speed even the least duty factor's stance sweep does not fit the legs' windows, or a
+    # stride cycle lasts under MIN_CYCLE_FRAMES frames (a tiny creature), or a stance sweep reaches
+    # into a neighbouring leg's territory, or a landing spot within a foot's room of the neighbouring
+    # leg's lift-off spot (dense legs): the controller caps the speed there (reported as speed_cap; the
+    # CLI says so).
+    caps = speed_caps(timing, h, rest_body, hips_body, window, DT, creature.foot_room)
+    cap_reason = min(caps, key=caps.get)
+    speed = min(float(speed_asked), caps[cap_reason])
+    # The leg-spacing reference no larger than the room the stride law leaves between neighbouring legs
+    # at this walk (planner.default_weights).
+    weights = default_weights(creature.rest_radius, leg_room(timing, h, rest_body, hips_body, window, speed,
+                                                             creature.foot_room, DT))
+    return CreatureWalk(rest_body, hips_body, leg_static, window, caps, cap_reason, caps[cap_reason], speed, weights)
+
+
 def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, seed: int = 0,
                weights: ScoringWeights | None = None, timing=None, lod_mode: str = "off",
                config: PlannerConfig | None = None, controller: ControllerConfig | None = None,
@@ -2940,7 +3037,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
     """
     from footfall._errors import InputError
     from footfall.planner._gait import init_gaits
-    from footfall.planner._ik import legs_of, rest_pose_angles
+    from footfall.planner._ik import rest_pose_angles
     from footfall.planner._timing import GaitTiming
 
     if lod_mode not in ("on", "zoomed", "off"):
@@ -2963,9 +3060,8 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
                          f"{config.map_cells} x {config.map_cells} local map of {config.cell_size} m cells")
     speed_asked = float(scenario.crowd.speed)
     spacing = float(scenario.crowd.feet_spacing)
-    hips_body = np.asarray(creature.hips, dtype=np.float64)
-    rest_body = spacing * np.asarray(creature.rest_feet, dtype=np.float64)
-    leg_static = legs_of(creature)
+    walk = creature_walk(creature, timing, speed_asked, spacing)
+    hips_body, rest_body, leg_static, window = walk.hips_body, walk.rest_body, walk.leg_static, walk.window
     # A safe box taller than the creature can step onto is forbidden for it (it walks around).
     from footfall.planner._workspace import highest_step
 
@@ -2983,24 +3079,12 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         raise ValueError(f"raster: cell size {raster.frame.cell_size} differs from the planner's {config.cell_size}")
     from footfall.planner._gait_schedule import as_schedule
     from footfall.planner._timing import GRAVITY, hip_height
-    from footfall.planner._workspace import height_ranges, leg_room, speed_caps, stance_windows, tuck_reaches
+    from footfall.planner._workspace import height_ranges, tuck_reaches
 
     schedule = as_schedule(gait)
-    window = stance_windows(creature, rest_body, hips_body, leg_static)
-    # Past this speed even the least duty factor's stance sweep does not fit the legs' windows, or a
-    # stride cycle lasts under MIN_CYCLE_FRAMES frames (a tiny creature), or a stance sweep reaches
-    # into a neighbouring leg's territory, or a landing spot within a foot's room of the neighbouring
-    # leg's lift-off spot (dense legs): the controller caps the speed there (reported as speed_cap; the
-    # CLI says so).
-    caps = speed_caps(timing, hip_height(creature), rest_body, hips_body, window, DT, creature.foot_room)
-    cap_reason = min(caps, key=caps.get)
-    cap = caps[cap_reason]
-    speed = min(speed_asked, cap)
+    cap_reason, cap, speed = walk.cap_reason, walk.cap, walk.speed
     if weights is None:
-        # The leg-spacing reference no larger than the room the stride law leaves between neighbouring
-        # legs at this walk (planner.default_weights).
-        weights = default_weights(creature.rest_radius, leg_room(timing, hip_height(creature), rest_body, hips_body,
-                                                                  window, speed, creature.foot_room, DT))
+        weights = walk.weights
     escape = min(cap, math.sqrt(ESCAPE_FROUDE * GRAVITY * hip_height(creature)))
     far_first, far_fallback = None, None
     if lod_mode != "off":

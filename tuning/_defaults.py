@@ -6,7 +6,8 @@ from __future__ import annotations
 def creature_defaults(creature: str):
     """The runtime's default :class:`planner.ScoringWeights` for ``creature`` (a built-in name or a
     creature file): the weights ``init_crowd`` gives it on ``flat`` when none are passed
-    (:func:`planner.default_weights` at its rest radius and the leg room of its walk there).
+    (:func:`planner.creature_walk`: :func:`planner.default_weights` at its rest radius and the leg room
+    of its walk there; no world is built).
 
     Parameters
     ----------
@@ -26,11 +27,8 @@ def creature_defaults(creature: str):
     >>> round(creature_defaults("ant").clearance_ref_m, 4)        # 0.47 x the spider's 7 cm: the ant's size
     0.033
     """
-    from footfall.planner import init_crowd
+    from footfall.planner import GaitTiming, creature_walk
     from footfall.scenarios import load_creature, load_scenario
-    from footfall.scenarios._gait_choice import resolve_gait
 
-    creature = load_creature(creature)
-    gait, _, _ = resolve_gait(None, creature)
-    model, _ = init_crowd(load_scenario("flat"), creature, gait, n_characters=1, seed=0)
-    return model.weights
+    flat = load_scenario("flat").crowd
+    return creature_walk(load_creature(creature), GaitTiming(), flat.speed, flat.feet_spacing).weights
