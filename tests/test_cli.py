@@ -242,7 +242,7 @@ def test_scenarios_lists_descriptions_creatures_and_gaits():
 
     rows = {line.split()[0]: line.split(None, 2)[1:] for line in out.split("Presets (")[1].splitlines()[1:]}
     shipped = {p.stem for p in shipped_preset_paths()}
-    assert set(rows) == shipped and {"spider", "spider-stairs"} <= shipped
+    assert set(rows) == shipped and {"spider", "quadruped-stairs"} <= shipped
     for name, (creature, what) in rows.items():
         spec = PRESETS.get(name)
         assert creature == (spec["creature"] if spec else name)

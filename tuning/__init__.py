@@ -44,7 +44,7 @@ def shipped_preset_paths() -> list[Path]:
     --------
     >>> from footfall.tuning import shipped_preset_paths
     >>> names = [path.stem for path in shipped_preset_paths()]
-    >>> {"spider", "quadruped", "spider-stairs"} <= set(names)
+    >>> {"spider", "quadruped", "quadruped-stairs"} <= set(names)
     True
     >>> any(name.endswith(".checkpoint") for name in names)
     False

@@ -36,7 +36,9 @@ with the stride frequency f(v) = max(v / lambda(v), min_frequency),
 lambda(v) = stride_coefficient * h * Fr^stride_exponent, the duty factor DF(v),
 t_stance = DF / f, and for a new swing t_swing = min(clip((1 - DF) r, 0.05, 0.95) / f, 1)
 (r = the leg's authored swing duration over the mean; a re-plan keeps the rest of
-the swing in progress, so its t_swing does not depend on theta). So P moves
+the swing in progress, so its t_swing does not depend on theta; the runtime also takes off a new swing's
+lateness, the part of a frame since the needle entered its sector, ``planner._crowd.lift_lateness``,
+which the harvest's P holds and the proxy keeps fixed: under a frame, 33 ms). So P moves
 along the heading by ``v * (g(theta) - g(theta_0))``, g = t_swing + t_stance / 2,
 with theta_0 the timing of the harvest: at theta_0 the proxy sees exactly the
 runtime's P. In steady walking the realised step (lift-off to touch-down of one
