@@ -215,8 +215,8 @@ LONE_WARM_UP_FRAMES = 60  # the first strides speed up from the spawn's standsti
 @pytest.mark.parametrize("name", ("spider", str(BEETLE)))
 def test_a_lone_walker_s_footprints_are_a_whole_cycle_apart_whatever_frame_each_foot_lifts_on(name):
     # One creature walking straight on flat ground at its asked speed: once up to speed, every stride it
-    # measures is the stride law's, on each foot and each cycle. A foot lifts on the first frame past the instant the gait's
-    # needle enters its sector; timed from that frame, consecutive footprints were 0 to 1 frame's travel
+    # measures is the stride law's, on each foot and each cycle. A foot lifts on the first frame past the
+    # instant the gait's needle enters its sector; timed from that frame, consecutive footprints were 0 to 1 frame's travel
     # more or less than a cycle apart (the spider's strides 0.9 % off the law at the median, 3 % at p90;
     # the beetle's, a cycle of 12.7 frames, 3.6 % and 5.7 %). They are timed from the instant
     # (planner._crowd.lift_lateness).
