@@ -865,7 +865,7 @@ def speed_cap_note(creature) -> tuple[str, str]:
     import numpy as np
 
     from footfall.planner import GaitTiming, creature_walk
-    from footfall.planner._workspace import SPEED_CAP_REASONS
+    from footfall.planner._workspace import speed_cap_why
 
     walk = creature_walk(creature, GaitTiming(), 0.0)  # its caps, whatever speed is asked
     caps, reason, windows = walk.caps, walk.cap_reason, walk.window
@@ -873,8 +873,7 @@ def speed_cap_note(creature) -> tuple[str, str]:
         stuck = [creature.leg_names[i] for i in np.flatnonzero(windows[:, 1] - windows[:, 0] <= 1e-9)]
         return "warning", (f"{creature.name} cannot walk: legs {', '.join(stuck)} carry no stance at its standing "
                            f"height (their stance windows are empty); it stands where it spawns")
-    return "note", (f"{creature.name} walks at most {caps[reason]:.3g} m/s, the fastest its legs carry at the "
-                    f"stride law where {SPEED_CAP_REASONS[reason]}")
+    return "note", f"{creature.name} walks at most {caps[reason]:.3g} m/s, {speed_cap_why(reason)}"
 
 
 def scoring_scales_note(rest_radius: float) -> str:

@@ -528,8 +528,17 @@ SPEED_CAP_REASONS = {
     "territories": "each stance sweep keeps to its leg's territory, clear of the neighbouring legs",
     "neighbours": "each foot lands a foot's room clear of the neighbouring leg's foot",
 }
-"""What sets each of :func:`speed_caps`' caps, said where a creature is capped (``footfall check``, the
-runs' stderr note): "the fastest its legs carry at the stride law where ..."."""
+"""What sets each of :func:`speed_caps`' caps (:func:`speed_cap_why`)."""
+
+
+def speed_cap_why(reason: str) -> str:
+    """Why a creature walks no faster than its cap, in the words ``footfall check`` and the runs' stderr note
+    both say (``reason``: a key of :data:`SPEED_CAP_REASONS`).
+
+    >>> speed_cap_why("frames")
+    'the fastest its legs carry at the stride law where a stride cycle lasts at least 4 frames'
+    """
+    return f"the fastest its legs carry at the stride law where {SPEED_CAP_REASONS[reason]}"
 
 
 def speed_caps(timing, leg_height: float, rest_body: np.ndarray, hips_body: np.ndarray, windows: np.ndarray,

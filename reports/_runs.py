@@ -33,13 +33,12 @@ def recorded_run(scenario, creature, gait, *, frames: int, characters: int | Non
 def speed_cap_message(model) -> str | None:
     """The note a run says when the creature's legs cannot carry the asked speed (the controller caps it),
     or None."""
-    from footfall.planner._workspace import SPEED_CAP_REASONS
+    from footfall.planner._workspace import speed_cap_why
 
     if model.speed_asked <= model.speed_cap:
         return None
     return (f"footfall: note: {model.creature.name}: {model.speed_asked:g} m/s asked; speed capped at "
-            f"{model.speed_cap:.3g} m/s, the fastest its legs carry at the stride law where "
-            f"{SPEED_CAP_REASONS[model.speed_cap_reason]}")
+            f"{model.speed_cap:.3g} m/s, {speed_cap_why(model.speed_cap_reason)}")
 
 
 def say_speed_cap(model) -> None:
