@@ -385,8 +385,9 @@ def neighbour_gaps(timing, leg_height: float, rest_body: np.ndarray, hips_body: 
     further back.
 
     In a wave gait the rear leg lands as its front neighbour is about to lift: at speed both stand at the
-    ends of their sweeps that face each other, and the search keeps a foot's room between feet and half of
-    it between a foot and a leg (``planner._kernels_foot.LEG_CLEARANCE``).
+    ends of their sweeps that face each other. The search keeps a foot's room between feet and refuses
+    half of it between a foot and a leg (``planner._kernels_foot.LEG_CLEARANCE``); the leg-spacing goodness
+    asks a whole room (:func:`neighbour_speed_cap`).
 
     Examples
     --------
@@ -423,20 +424,26 @@ def neighbour_gaps(timing, leg_height: float, rest_body: np.ndarray, hips_body: 
 def neighbour_speed_cap(timing, leg_height: float, rest_body: np.ndarray, hips_body: np.ndarray,
                         windows: np.ndarray, fastest: float, foot_room: float) -> float:
     """The fastest speed (m/s, at most ``fastest``) at which the steady landing and lift-off spots of
-    legs next to each other keep the search's rooms (:func:`neighbour_gaps`): ``foot_room`` between the
-    feet, ``LEG_CLEARANCE`` of it between a foot and the other leg; ``inf`` when they keep them up to
-    ``fastest``, or keep them at no speed tried (:func:`territory_speed_cap`'s speeds).
+    legs next to each other keep ``foot_room`` from each other and from the other leg's line
+    (:func:`neighbour_gaps`); ``inf`` when they keep it up to ``fastest``, or keep it at no speed tried
+    (:func:`territory_speed_cap`'s speeds).
 
     Past it, the rear leg's landing spot is refused or scored down beside its neighbour's foot, and the
     foot lands a cell short of the stride law: random creatures whose rest feet were 4 cm apart, walked at
     their territory cap, landed their rear feet 1.3-2.9 cm short of 5 cm strides (per-stride p90 0.28-0.69).
-    The steady spots only: a front foot lifting a frame late stands nearer still, but capping for it put
-    the spider's cap (0.63 m/s) under its Fr 0.5 top speed (:func:`leg_room` allows for it instead).
+    A whole room from the other leg, not the half the search refuses under (``LEG_CLEARANCE``): the
+    leg-spacing reference is at least a foot's room (:func:`leg_room`), so at a cap that kept only half of
+    it the law's own spot scored half on leg spacing, and a spot a cell short won (random 6- and
+    8-legged creatures at their caps, alone on flat ground: per-stride median 0.04-0.10, p90 0.21-0.36;
+    0.00 and 0.01-0.14 with the whole room, the planner also leaving out the feet that lift before a foot
+    lands, ``planner._crowd.lifted_before``). The steady spots only: a front foot lifting a frame late
+    stands nearer still, but capping for it put the spider's cap (0.63 m/s) under its Fr 0.5 top speed
+    (:func:`leg_room` allows for it instead).
 
     Examples
     --------
     :func:`neighbour_gaps`' legs with a 1 cm foot room: the ends facing each other come within a room once
-    the sweeps reach 3 cm (0.04 - 0.03 = 0.01 m).
+    the sweeps reach 3 cm (0.04 - 0.03 = 0.01 m); the spots keep more than that from the other leg.
 
     >>> import numpy as np
     >>> from footfall.planner._timing import GaitTiming, duty_factor, stride_length
@@ -447,13 +454,11 @@ def neighbour_speed_cap(timing, leg_height: float, rest_body: np.ndarray, hips_b
     >>> round(v, 3), round(float(duty_factor(GaitTiming(), v, 0.025) * stride_length(GaitTiming(), v, 0.025)), 4)
     (0.531, 0.03)
     """
-    from footfall.planner._kernels_foot import LEG_CLEARANCE
-
     if not side_neighbours(rest_body, hips_body) or not math.isfinite(fastest) or fastest <= 0.0:
         return math.inf
     speeds = _speeds_up_to(fastest)
     feet, legs = neighbour_gaps(timing, leg_height, rest_body, hips_body, windows, speeds)
-    return _fastest_kept(speeds, (feet >= foot_room) & (legs >= LEG_CLEARANCE * foot_room))
+    return _fastest_kept(speeds, (feet >= foot_room) & (legs >= foot_room))
 
 
 MIN_CYCLE_FRAMES = 4
@@ -526,7 +531,7 @@ SPEED_CAP_REASONS = {
     "windows": "its stance sweeps fit its legs' stance windows",
     "frames": f"a stride cycle lasts at least {MIN_CYCLE_FRAMES} frames",
     "territories": "each stance sweep keeps to its leg's territory, clear of the neighbouring legs",
-    "neighbours": "each foot lands a foot's room clear of the neighbouring leg's foot",
+    "neighbours": "each foot lands a foot's room clear of the neighbouring leg and its foot",
 }
 """What sets each of :func:`speed_caps`' caps (:func:`speed_cap_why`)."""
 

@@ -41,7 +41,7 @@ def test_check_says_how_fast_a_creature_walks_and_what_caps_it():
     creature = load_creature(str(splay8))
     model, _ = init_crowd(load_scenario("flat"), creature, resolve_gait(None, creature)[0], n_characters=1)
     assert (f"splay8 walks at most {model.speed_cap:.3g} m/s, the fastest its legs carry at the stride law where "
-            "each foot lands a foot's room clear of the neighbouring leg's foot") in done.stderr
+            "each foot lands a foot's room clear of the neighbouring leg and its foot") in done.stderr
     done = footfall_cli("check", "robot5")
     assert "robot5 walks at most 2.06 m/s" in done.stderr and "stance windows" in done.stderr, done.stderr
 
