@@ -1308,16 +1308,22 @@ def leg_speed_caps(model: CrowdModel, state: CrowdState, room=None, lift=None) -
     return np.where(state.in_stance, np.maximum(room, 0.0) / lift, np.inf)
 
 
+def _until_sector(model: CrowdModel, state: CrowdState, frequency) -> np.ndarray:
+    """(C, L) s until the needle, turning at ``frequency`` (C,) Hz (> 0), enters each foot's sector, and the frame
+    the foot lifts on (it lifts the frame its sector starts)."""
+    g = state.gaits
+    return np.mod(g.disk_start - g.needle[:, None], 1.0) / frequency[:, None] + model.dt
+
+
 def until_lift(model: CrowdModel, state: CrowdState) -> np.ndarray:
     """(C, L) s: how long each foot has until the needle lifts it (at least a frame)."""
-    g = state.gaits
     # A body standing has no tempo (0 Hz): its feet lift when it walks again, at the tempo of the walk
     # it resumes. Counting them a cycle of 0 Hz away made every stance foot 'hold the body' (cap 0):
     # forced steps of the feet just landed, again and again, while the feet at the rear end of their
     # windows never got their turn (a spider stood on a hill for good with four feet in the air).
     resume = resume_frequency(model, state)
-    frequency = np.maximum(np.where(state.stride_frequency > 0.0, state.stride_frequency, resume), 1e-9)[:, None]
-    time = np.mod(g.disk_start - g.needle[:, None], 1.0) / frequency + model.dt  # lifts the frame its sector starts
+    frequency = np.maximum(np.where(state.stride_frequency > 0.0, state.stride_frequency, resume), 1e-9)
+    time = _until_sector(model, state, frequency)
     # A foot whose sector has started but which has not lifted yet (its plan is pending) lifts as
     # soon as it can: its next turn is not a cycle away.
     return np.where(state.wants_swing | state.sector_missed, model.dt, time)
@@ -1776,11 +1782,9 @@ def lifted_before(model: CrowdModel, state: CrowdState, cs, others, t_land) -> n
     neighbour cap (:func:`at_neighbour_cap`): below it the law's spots keep more than a room, and leaving them
     out changed the spider's crowded runs among crates for the worse (10 runs of 6 spiders on ``crates``: the
     per-stride median 0.026 -> 0.032, one run over the p90 bar), while on ``crates-moving`` it fell 0.014 -> 0.009."""
-    g = state.gaits
     c = cs[:, None]
-    tempo = np.where(state.body_held | (state.speed <= 0.0), 0.0, state.stride_frequency)[c]
-    phase = np.mod(g.disk_start[c, others] - g.needle[c], 1.0)
-    lift = np.where(tempo > 0.0, phase / np.maximum(tempo, 1e-300) + model.dt, np.inf)  # as until_lift counts
+    tempo = np.where(state.body_held | (state.speed <= 0.0), 0.0, state.stride_frequency)
+    lift = np.where((tempo > 0.0)[:, None], _until_sector(model, state, np.maximum(tempo, 1e-300)), np.inf)[c, others]
     sure = state.in_stance[c, others] & ~state.wants_swing[c, others] & ~state.sector_missed[c, others]
     gone = sure & (lift < np.asarray(t_land)[:, None])
     return np.concatenate([gone, gone], axis=1)
