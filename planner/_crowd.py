@@ -290,8 +290,8 @@ class CrowdModel:
     speed_cap_reason: str = "windows"
     speed_asked: float = 0.0  # m/s, the scenario's speed before the cap
     step_height: float = 0.0  # m, the swings' preferred lift (paper §3.1 'step height')
-    # m/s, the fastest a character walks to get out of the way (of a box, of another): its speed
-    # cap, at most Froude number ESCAPE_FROUDE. A box at least this fast cannot be escaped.
+    # m/s, the fastest a character walks to get out of the way (of a box, of another): its legs' escape cap
+    # (CreatureWalk.escape_cap), at most Froude number ESCAPE_FROUDE. A box at least this fast cannot be escaped.
     top_speed: float = math.inf
     height_range: np.ndarray | None = None  # (L, 2) m, least and most pelvis height above each foot (planner._workspace)
     tuck_reach: np.ndarray | None = None  # (L, len(TUCK_REACHES)) the tuck points' reaches the legs reach (planner._workspace)
@@ -2962,6 +2962,12 @@ class CreatureWalk:
         ``planner._workspace.speed_caps``: m/s by what sets each.
     cap_reason : str
         The least of them, ``cap`` its speed (m/s).
+    escape_cap : float
+        The fastest its legs carry with no law's landing spot refused (m/s): the caps with half a foot's room
+        between a spot and a neighbouring leg (``planner._kernels_foot.LEG_CLEARANCE``), not the whole room
+        that ``cap`` keeps so that the law's spot scores best. A character fleeing a box or making way walks
+        up to it (``CrowdModel.top_speed``): held to ``cap``, large random creatures stood in crates' and
+        each other's way longer (three of them 1.7 -> 10.5 s stuck over their 36 runs, session 67).
     speed : float
         The speed walked: the asked one, at most ``cap``.
     weights : ScoringWeights
@@ -2984,6 +2990,7 @@ class CreatureWalk:
     caps: dict
     cap_reason: str
     cap: float
+    escape_cap: float
     speed: float
     weights: ScoringWeights
 
@@ -3014,10 +3021,13 @@ def creature_walk(creature, timing, speed_asked: float, feet_spacing: float = 1.
     >>> walk = creature_walk(load_creature("spider"), GaitTiming(), 0.3)
     >>> walk.cap_reason, round(walk.cap, 3), walk.speed   # its feet keep clear of each other up to 0.76 m/s
     ('neighbours', 0.757, 0.3)
+    >>> round(walk.escape_cap, 3)                          # and none of its law's spots is refused up to 0.9
+    0.898
     >>> walk.weights == ScoringWeights()                   # the room its law leaves is more than it asks
     True
     """
     from footfall.planner._ik import legs_of
+    from footfall.planner._kernels_foot import LEG_CLEARANCE
     from footfall.planner._timing import hip_height
     from footfall.planner._workspace import leg_room, speed_caps, stance_windows
 
@@ -3032,13 +3042,17 @@ def creature_walk(creature, timing, speed_asked: float, feet_spacing: float = 1.
     # leg's lift-off spot (dense legs): the controller caps the speed there (reported as speed_cap; the
     # CLI says so).
     caps = speed_caps(timing, h, rest_body, hips_body, window, DT, creature.foot_room)
+    # How fast it may flee: every law's spot still allowed, if not scored best (CreatureWalk.escape_cap).
+    escape_cap = min(speed_caps(timing, h, rest_body, hips_body, window, DT, creature.foot_room,
+                                LEG_CLEARANCE).values())
     cap_reason = min(caps, key=caps.get)
     speed = min(float(speed_asked), caps[cap_reason])
     # The leg-spacing reference no larger than the room the stride law leaves between neighbouring legs
     # at this walk (planner.default_weights).
     weights = default_weights(creature.rest_radius, leg_room(timing, h, rest_body, hips_body, window, speed,
                                                              creature.foot_room, DT))
-    return CreatureWalk(rest_body, hips_body, leg_static, window, caps, cap_reason, caps[cap_reason], speed, weights)
+    return CreatureWalk(rest_body, hips_body, leg_static, window, caps, cap_reason, caps[cap_reason], escape_cap, speed,
+                        weights)
 
 
 def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, seed: int = 0,
@@ -3169,7 +3183,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
     cap_reason, cap, speed = walk.cap_reason, walk.cap, walk.speed
     if weights is None:
         weights = walk.weights
-    escape = min(cap, math.sqrt(ESCAPE_FROUDE * GRAVITY * hip_height(creature)))
+    escape = min(walk.escape_cap, math.sqrt(ESCAPE_FROUDE * GRAVITY * hip_height(creature)))
     far_first, far_fallback = None, None
     if lod_mode != "off":
         from footfall.planner._far_planning import far_configs

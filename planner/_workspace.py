@@ -422,23 +422,24 @@ def neighbour_gaps(timing, leg_height: float, rest_body: np.ndarray, hips_body: 
 
 
 def neighbour_speed_cap(timing, leg_height: float, rest_body: np.ndarray, hips_body: np.ndarray,
-                        windows: np.ndarray, fastest: float, foot_room: float) -> float:
+                        windows: np.ndarray, fastest: float, foot_room: float, leg_share: float = 1.0) -> float:
     """The fastest speed (m/s, at most ``fastest``) at which the steady landing and lift-off spots of
-    legs next to each other keep ``foot_room`` from each other and from the other leg's line
-    (:func:`neighbour_gaps`); ``inf`` when they keep it up to ``fastest``, or keep it at no speed tried
-    (:func:`territory_speed_cap`'s speeds).
+    legs next to each other keep ``foot_room`` from each other and ``leg_share`` of it from the other leg's
+    line (:func:`neighbour_gaps`); ``inf`` when they keep them up to ``fastest``, or keep them at no speed
+    tried (:func:`territory_speed_cap`'s speeds).
 
     Past it, the rear leg's landing spot is refused or scored down beside its neighbour's foot, and the
     foot lands a cell short of the stride law: random creatures whose rest feet were 4 cm apart, walked at
     their territory cap, landed their rear feet 1.3-2.9 cm short of 5 cm strides (per-stride p90 0.28-0.69).
-    A whole room from the other leg, not the half the search refuses under (``LEG_CLEARANCE``): the
+    A whole room from the other leg by default, not the half the search refuses under (``LEG_CLEARANCE``): the
     leg-spacing reference is at least a foot's room (:func:`leg_room`), so at a cap that kept only half of
     it the law's own spot scored half on leg spacing, and a spot a cell short won (random 6- and
     8-legged creatures at their caps, alone on flat ground: per-stride median 0.04-0.10, p90 0.21-0.36;
     0.00 and 0.01-0.14 with the whole room, the planner also leaving out the feet that lift before a foot
     lands, ``planner._crowd.lifted_before``). The steady spots only: a front foot lifting a frame late
     stands nearer still, but capping for it put the spider's cap (0.63 m/s) under its Fr 0.5 top speed
-    (:func:`leg_room` allows for it instead).
+    (:func:`leg_room` allows for it instead). With ``leg_share`` ``LEG_CLEARANCE`` it is the fastest at which
+    no law's spot is refused: how fast a character may flee (``planner._crowd.creature_walk``'s ``escape_cap``).
 
     Examples
     --------
@@ -458,7 +459,7 @@ def neighbour_speed_cap(timing, leg_height: float, rest_body: np.ndarray, hips_b
         return math.inf
     speeds = _speeds_up_to(fastest)
     feet, legs = neighbour_gaps(timing, leg_height, rest_body, hips_body, windows, speeds)
-    return _fastest_kept(speeds, (feet >= foot_room) & (legs >= foot_room))
+    return _fastest_kept(speeds, (feet >= foot_room) & (legs >= leg_share * foot_room))
 
 
 MIN_CYCLE_FRAMES = 4
@@ -547,11 +548,12 @@ def speed_cap_why(reason: str) -> str:
 
 
 def speed_caps(timing, leg_height: float, rest_body: np.ndarray, hips_body: np.ndarray, windows: np.ndarray,
-               dt: float, foot_room: float = 0.0) -> dict:
+               dt: float, foot_room: float = 0.0, leg_share: float = 1.0) -> dict:
     """The speeds (m/s) past which the legs cannot carry the stride law, by what sets each:
     ``"windows"`` (:func:`speed_cap` of the narrowest stance window), ``"frames"``
     (:func:`frame_rate_cap`), ``"territories"`` (:func:`territory_speed_cap` below the other two) and
-    ``"neighbours"`` (:func:`neighbour_speed_cap` with ``foot_room`` (m), below the other three). The crowd
+    ``"neighbours"`` (:func:`neighbour_speed_cap` with ``foot_room`` (m) and ``leg_share``, below the other
+    three). The crowd
     walks no faster than the least of them (``init_crowd``; ``CrowdModel.speed_cap`` and
     ``speed_cap_reason``).
 
@@ -573,7 +575,7 @@ def speed_caps(timing, leg_height: float, rest_body: np.ndarray, hips_body: np.n
             "frames": frame_rate_cap(timing, leg_height, dt)}
     caps["territories"] = territory_speed_cap(timing, leg_height, rest_body, hips_body, windows, min(caps.values()))
     caps["neighbours"] = neighbour_speed_cap(timing, leg_height, rest_body, hips_body, windows, min(caps.values()),
-                                             foot_room)
+                                             foot_room, leg_share)
     return caps
 
 

@@ -355,7 +355,8 @@ def test_dense_legs_walk_no_faster_than_their_feet_keep_clear_of_their_neighbour
     # keep a foot's room (neighbour_speed_cap; from the other leg's line too since session 67), and the
     # leg-spacing reference is no more than the room they leave, and a foot's room (planner._workspace.leg_room).
     from footfall.planner import default_weights
-    from footfall.planner._crowd import DT, init_crowd
+    from footfall.planner._crowd import DT, ESCAPE_FROUDE, init_crowd
+    from footfall.planner._kernels_foot import LEG_CLEARANCE
     from footfall.planner._simulation import simulate
     from footfall.planner._timing import hip_height
     from footfall.planner._workspace import leg_room, neighbour_gaps, speed_caps
@@ -376,6 +377,9 @@ def test_dense_legs_walk_no_faster_than_their_feet_keep_clear_of_their_neighbour
     # The leg-spacing reference: the room the law leaves at the walk, under the size-scaled default.
     scaled = default_weights(creature.rest_radius).leg_spacing_ref_m
     assert model.weights.leg_spacing_ref_m == leg_room(*geometry, model.speed_cap, room, DT) < 0.6 * scaled
+    # It flees no faster than keeps every law's spot allowed (half a room from the other leg), above its walk.
+    flee = min(speed_caps(*geometry, DT, room, LEG_CLEARANCE).values())
+    assert model.top_speed == min(flee, math.sqrt(ESCAPE_FROUDE * GRAVITY * h)) and flee > model.speed_cap
     summary = simulate(model, state, 150)
     assert summary.leg_crossings == 0 and summary.holds <= 2
     assert summary.speed_reached > 0.9 * model.speed_cap  # measured 1.0 (both)
