@@ -433,6 +433,9 @@ class CrowdState:
     lod_level: np.ndarray | None = None  # (C,) int8: each character's level of detail (planner._lod, LEVEL_*)
     near_moving_box: np.ndarray | None = None  # (C,) bool: a moving box is near: it plans as a near character
     aim_node: np.ndarray | None = None  # (C,) int: the corner of the way round static boxes aimed at (-1: none)
+    # (C, L, L) bool: [c, l, j] the swing of foot l was planned with foot j left out, as lifting before it lands
+    # (lifted_before); while j still stands waiting for its own footprint, l plans again (stage_requests)
+    counted_gone: np.ndarray | None = None
 
 
 def hips_world(model: CrowdModel, state: CrowdState) -> np.ndarray:
@@ -1879,6 +1882,7 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, fre
     """(C, L) int8 request kinds: 0 none, 1 new swing, 2 forced step, 3 re-plan. ``drawn``: the legs as
     drawn at ``hips`` (:func:`rendered_joints`; computed here unless the caller has them)."""
     ctl = model.controller
+    waited = state.wants_swing & state.in_stance  # asked for a swing on an earlier frame, and still standing
     state.wants_swing |= (enter | state.sector_missed) & state.in_stance
     state.sector_missed &= ~state.in_stance
     kinds = np.zeros(state.in_stance.shape, dtype=np.int8)
@@ -1997,7 +2001,16 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, fre
     # A tucked foot looks for a footprint every frame (the body moves on without it).
     # So does a foot in the air a shove carried onto another character's foot, landing or not (shoved by
     # the tuck distance, mixed, 64 ants, seed 2 had a foot spot shared with a neighbour in three frames).
-    kinds[swinging & (((turned | sped | respaced) & ~landing) | invalid | state.tucked | state.shoved_onto_feet)] = 3
+    # A swing planned with a neighbour's foot left out as lifting first (lifted_before) whose neighbour still
+    # stands, waiting since an earlier frame for a footprint it has not found, or held by a body that stopped:
+    # the foot plans again with that foot standing. Landed on the plan, a rear foot stood across its front
+    # neighbour's leg, which lifted 10 frames late (a random 6-legged creature on `crates`).
+    late_lift = np.zeros_like(swinging)
+    if state.counted_gone is not None:
+        stopped = (state.body_held | (state.speed <= 0.0))[:, None] & state.in_stance
+        late_lift = swinging & (state.counted_gone & (waited | stopped)[:, None, :]).any(axis=2)
+    kinds[swinging & (((turned | sped | respaced) & ~landing) | invalid | state.tucked | state.shoved_onto_feet
+                      | late_lift)] = 3
     return kinds
 
 
@@ -2249,6 +2262,7 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
         drawn = rendered_joints(model, state, hips)
     drawn_rows, drawn_start = drawn_leg_segments(drawn, cs, oj, now)
     legs, legs_start = _with_neighbours_feet(model, state, cs, own, drawn_rows, drawn_start, preferred, support)
+    gone = np.zeros((f, 2 * oj.shape[1]), np.bool_)
     if at_neighbour_cap(model):
         gone = lifted_before(model, state, cs, oj, t_land) & (kinds[cs, ls] == KIND_NEW_SWING)[:, None]
         legs[_own_rows(legs_start, oj.shape[1])[gone], LEG_FOOT] = 0.0
@@ -2282,6 +2296,9 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
                                      state.swing_T[cs, ls], ~ok & ~new & ~state.in_stance[cs, ls],
                                      state.foot_yaws[cs, ls])
     vc, vl = cs[ok], ls[ok]
+    if state.counted_gone is not None:
+        state.counted_gone[vc, vl] = False
+        state.counted_gone[vc[:, None], vl[:, None], oj[ok]] = gone[ok, :oj.shape[1]]
     state.trajectories[vc, vl] = out.trajectory[ok]
     state.swing_t[vc, vl] = 0.0
     state.swing_T[vc, vl] = t_swing[ok]
@@ -3241,7 +3258,7 @@ def init_crowd(scenario, creature, gait, *, n_characters: int | None = None, see
         ik_on=np.zeros(n, np.bool_), fk_feet=feet.copy(), pelvis_base=np.zeros(n), pelvis_rise=np.zeros(n), body_held=np.zeros(n, np.bool_), speed_limit=np.full(n, np.inf), last_move=np.zeros((n, 2)), cannot_follow=np.zeros((n, L), np.bool_), unfollowed=np.zeros((n, L), np.bool_), pose_before=np.zeros((n, 7)),
         gait_index=gait_index, stride_frequency=np.zeros(n), turn_wanted=np.zeros(n), turn_left=np.zeros(n), turn_made=np.zeros(n),
         threatened=np.zeros((n, L), np.bool_), tucked=np.zeros((n, L), np.bool_),
-        escaping=np.zeros(n, np.bool_), shoved=np.zeros(n, np.bool_), shoved_onto_feet=np.zeros((n, L), np.bool_), goal_speed=np.full(n, speed), speed_wanted=np.zeros(n), blocks_escape=np.zeros((n, L), np.bool_), crossed=np.zeros((n, L, L), np.bool_),
+        escaping=np.zeros(n, np.bool_), shoved=np.zeros(n, np.bool_), shoved_onto_feet=np.zeros((n, L), np.bool_), goal_speed=np.full(n, speed), speed_wanted=np.zeros(n), blocks_escape=np.zeros((n, L), np.bool_), crossed=np.zeros((n, L, L), np.bool_), counted_gone=np.zeros((n, L, L), np.bool_),
         counters={k: 0 for k in ("steps", "plans", "holds", "replans", "forbidden_footprints", "cells_expanded",
                                  "couples_evaluated", "pose_takebacks", "crossing_takebacks", "map_cells_built", "ik_ccd_legs", "ik_two_bone_legs", "shoves",
                                  "boxed_ways", "landing_drops")},

@@ -467,6 +467,44 @@ def test_a_foot_that_lifts_before_another_lands_stands_nowhere_at_that_touchdown
         getattr(state, stands)[:] = saved
 
 
+def test_a_swing_planned_on_a_lift_that_does_not_come_plans_again():
+    # wave6 at its neighbour cap: a new swing leaves out the feet that lift before it lands (lifted_before) and
+    # says which (CrowdState.counted_gone). If one of them still stands, waiting since an earlier frame for a
+    # footprint of its own, or held by a body that stopped, the swing plans again with it standing: a rear foot
+    # of a random 6-legged creature on `crates` landed across its front neighbour's leg, which lifted 10 frames
+    # late.
+    import copy
+
+    import footfall.planner._crowd as crowd
+    from footfall.planner.layout import KIND_REPLAN
+    from footfall.scenarios import load_scenario
+    from footfall.scenarios._gait_choice import resolve_gait
+
+    creature = load_creature(str(CREATURES / "wave6.toml"))
+    gait, _, _ = resolve_gait(None, creature)
+    model, state = crowd.init_crowd(load_scenario("flat"), creature, gait, n_characters=1, seed=0)
+    assert crowd.at_neighbour_cap(model)
+    for _ in range(200):
+        crowd.step(model, state)
+        swinging = ~state.in_stance[0]
+        counted = state.counted_gone[0] & swinging[:, None] & state.in_stance[0][None, :]
+        if counted.any():
+            break
+    leg, other = map(int, np.argwhere(counted)[0])
+    assert state.swing_T[0, leg] - state.swing_t[0, leg] > 3 * model.dt, "the premise: the swing is not landing"
+
+    def kinds_next_frame(waits):
+        s = copy.deepcopy(state)
+        s.wants_swing[0, other] = waits  # asked for its swing on an earlier frame, and still standing
+        boxes = crowd._boxes_now(model, s.t)
+        frequency, enter, _ = crowd.stage_gait(model, s)
+        hips = crowd.hips_world(model, s)
+        return crowd.stage_requests(model, s, enter, boxes, hips, frequency)
+
+    assert kinds_next_frame(True)[0, leg] == KIND_REPLAN
+    assert kinds_next_frame(False)[0, leg] != KIND_REPLAN
+
+
 def test_neighbour_gaps_of_two_legs_by_hand():
     """Two legs on the left, hips at (0.01, 0.01) and (-0.01, 0.01), rest feet at (0.02, 0.05) and
     (-0.02, 0.05), windows of +-3 cm round them. Standing (no sweep): the feet 4 cm apart; the rear foot
