@@ -1765,6 +1765,11 @@ def at_neighbour_cap(model: CrowdModel) -> bool:
     return model.speed_cap_reason == "neighbours" and model.speed_asked >= model.speed_cap
 
 
+def _standing(state: CrowdState) -> np.ndarray:
+    """(C,) bool: bodies that stand, held or stopped by their steering: their needles stop, and no foot lifts."""
+    return state.body_held | (state.speed <= 0.0)
+
+
 def lifted_before(model: CrowdModel, state: CrowdState, cs, others, t_land) -> np.ndarray:
     """(F, 2 K) bool, as :func:`_own_rows` orders them: which of each planned foot's other legs (``others``
     (F, K) of character ``cs`` (F,)) stand now and lift before the foot lands ``t_land`` (F,) s from now
@@ -1786,7 +1791,7 @@ def lifted_before(model: CrowdModel, state: CrowdState, cs, others, t_land) -> n
     out changed the spider's crowded runs among crates for the worse (10 runs of 6 spiders on ``crates``: the
     per-stride median 0.026 -> 0.032, one run over the p90 bar), while on ``crates-moving`` it fell 0.014 -> 0.009."""
     c = cs[:, None]
-    tempo = np.where(state.body_held | (state.speed <= 0.0), 0.0, state.stride_frequency)
+    tempo = np.where(_standing(state), 0.0, state.stride_frequency)
     lift = np.where((tempo > 0.0)[:, None], _until_sector(model, state, np.maximum(tempo, 1e-300)), np.inf)[c, others]
     sure = state.in_stance[c, others] & ~state.wants_swing[c, others] & ~state.sector_missed[c, others]
     gone = sure & (lift < np.asarray(t_land)[:, None])
@@ -2007,7 +2012,7 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, fre
     # neighbour's leg, which lifted 10 frames late (a random 6-legged creature on `crates`).
     late_lift = np.zeros_like(swinging)
     if state.counted_gone is not None:
-        stopped = (state.body_held | (state.speed <= 0.0))[:, None] & state.in_stance
+        stopped = _standing(state)[:, None] & state.in_stance
         late_lift = swinging & (state.counted_gone & (waited | stopped)[:, None, :]).any(axis=2)
     kinds[swinging & (((turned | sped | respaced) & ~landing) | invalid | state.tucked | state.shoved_onto_feet
                       | late_lift)] = 3
@@ -3046,7 +3051,7 @@ def creature_walk(creature, timing, speed_asked: float, feet_spacing: float = 1.
     from footfall.planner._ik import legs_of
     from footfall.planner._kernels_foot import LEG_CLEARANCE
     from footfall.planner._timing import hip_height
-    from footfall.planner._workspace import leg_room, speed_caps, stance_windows
+    from footfall.planner._workspace import leg_room, neighbour_speed_cap, speed_caps, stance_windows
 
     hips_body = np.asarray(creature.hips, dtype=np.float64)
     rest_body = float(feet_spacing) * np.asarray(creature.rest_feet, dtype=np.float64)
@@ -3059,9 +3064,11 @@ def creature_walk(creature, timing, speed_asked: float, feet_spacing: float = 1.
     # leg's lift-off spot (dense legs): the controller caps the speed there (reported as speed_cap; the
     # CLI says so).
     caps = speed_caps(timing, h, rest_body, hips_body, window, DT, creature.foot_room)
-    # How fast it may flee: every law's spot still allowed, if not scored best (CreatureWalk.escape_cap).
-    escape_cap = min(speed_caps(timing, h, rest_body, hips_body, window, DT, creature.foot_room,
-                                LEG_CLEARANCE).values())
+    # How fast it may flee: every law's spot still allowed, if not scored best (CreatureWalk.escape_cap): the
+    # neighbour cap again with half a room from the other leg, under the other caps.
+    others = min(v for reason, v in caps.items() if reason != "neighbours")
+    escape_cap = min(others, neighbour_speed_cap(timing, h, rest_body, hips_body, window, others, creature.foot_room,
+                                                 LEG_CLEARANCE))
     cap_reason = min(caps, key=caps.get)
     speed = min(float(speed_asked), caps[cap_reason])
     # The leg-spacing reference no larger than the room the stride law leaves between neighbouring legs

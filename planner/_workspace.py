@@ -548,12 +548,11 @@ def speed_cap_why(reason: str) -> str:
 
 
 def speed_caps(timing, leg_height: float, rest_body: np.ndarray, hips_body: np.ndarray, windows: np.ndarray,
-               dt: float, foot_room: float = 0.0, leg_share: float = 1.0) -> dict:
+               dt: float, foot_room: float = 0.0) -> dict:
     """The speeds (m/s) past which the legs cannot carry the stride law, by what sets each:
     ``"windows"`` (:func:`speed_cap` of the narrowest stance window), ``"frames"``
     (:func:`frame_rate_cap`), ``"territories"`` (:func:`territory_speed_cap` below the other two) and
-    ``"neighbours"`` (:func:`neighbour_speed_cap` with ``foot_room`` (m) and ``leg_share``, below the other
-    three). The crowd
+    ``"neighbours"`` (:func:`neighbour_speed_cap` with ``foot_room`` (m), below the other three). The crowd
     walks no faster than the least of them (``init_crowd``; ``CrowdModel.speed_cap`` and
     ``speed_cap_reason``).
 
@@ -575,7 +574,7 @@ def speed_caps(timing, leg_height: float, rest_body: np.ndarray, hips_body: np.n
             "frames": frame_rate_cap(timing, leg_height, dt)}
     caps["territories"] = territory_speed_cap(timing, leg_height, rest_body, hips_body, windows, min(caps.values()))
     caps["neighbours"] = neighbour_speed_cap(timing, leg_height, rest_body, hips_body, windows, min(caps.values()),
-                                             foot_room, leg_share)
+                                             foot_room)
     return caps
 
 

@@ -359,7 +359,7 @@ def test_dense_legs_walk_no_faster_than_their_feet_keep_clear_of_their_neighbour
     from footfall.planner._kernels_foot import LEG_CLEARANCE
     from footfall.planner._simulation import simulate
     from footfall.planner._timing import hip_height
-    from footfall.planner._workspace import leg_room, neighbour_gaps, speed_caps
+    from footfall.planner._workspace import leg_room, neighbour_gaps, neighbour_speed_cap, speed_caps
     from footfall.scenarios import load_scenario
     from footfall.scenarios._gait_choice import resolve_gait
 
@@ -378,7 +378,8 @@ def test_dense_legs_walk_no_faster_than_their_feet_keep_clear_of_their_neighbour
     scaled = default_weights(creature.rest_radius).leg_spacing_ref_m
     assert model.weights.leg_spacing_ref_m == leg_room(*geometry, model.speed_cap, room, DT) < 0.6 * scaled
     # It flees no faster than keeps every law's spot allowed (half a room from the other leg), above its walk.
-    flee = min(speed_caps(*geometry, DT, room, LEG_CLEARANCE).values())
+    others = min(v for reason, v in caps.items() if reason != "neighbours")
+    flee = min(others, neighbour_speed_cap(*geometry, others, room, LEG_CLEARANCE))
     assert model.top_speed == min(flee, math.sqrt(ESCAPE_FROUDE * GRAVITY * h)) and flee > model.speed_cap
     summary = simulate(model, state, 150)
     assert summary.leg_crossings == 0 and summary.holds <= 2
