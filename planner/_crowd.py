@@ -617,8 +617,26 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
     # abreast of another on `stairs` turned +-0.05 rad every frame between its way and the kept-right
     # velocity, avoiding one frame and not the next (seed 3000, character 1, frames 15-140).
     steered = np.hypot(*(velocity - preferred).T) > 1e-9
-    direction = np.where((steered & fast & ~backward)[:, None],
-                         velocity / np.maximum(np.hypot(*velocity.T), 1e-12)[:, None], direction)
+    to_velocity = velocity / np.maximum(np.hypot(*velocity.T), 1e-12)[:, None]
+    # A velocity more than a quarter turn off the way is a yield: the heading goes between it and the way,
+    # by the share of its pace the velocity keeps (all the way to it at the pace, none at a standstill), and
+    # the body walks along its heading only as far as the velocity goes. Turned to face a slow yielding
+    # velocity, a walker faced away from its way once the other had passed and came round again at its
+    # turn rate: a quadruped yielding to a neighbour at 0.1 m/s turned from its way to 2.6 rad off it and
+    # back, 3.4 rad in all (crates-moving, seed 18102, character 4: stuck 0.13 s; docs/crowds.md has the
+    # runs this and SEPARATION_S changed). Not for an escaper: its flight out of a lane has rules of its own
+    # (above; among neighbours ORCA's velocity leads it).
+    fwd_now = np.stack([np.cos(state.heading), np.sin(state.heading)], axis=1)
+    retreat = steered & fast & ~in_lane & ((to_velocity * direction).sum(axis=1) < 0.0)
+    if retreat.any():
+        kept = np.clip(np.hypot(*velocity.T) / np.maximum(goal_speed, 1e-12), 0.0, 1.0)[:, None]
+        between = kept * to_velocity + (1.0 - kept) * direction
+        length = np.hypot(*between.T)
+        # (opposite and at half the pace, the two cancel: the heading stays)
+        between = np.where((length > 1e-6)[:, None], between / np.maximum(length, 1e-12)[:, None], fwd_now)
+        to_velocity = np.where(retreat[:, None], between, to_velocity)
+    along_now = (velocity * fwd_now).sum(axis=1)
+    direction = np.where((steered & fast & ~backward)[:, None], to_velocity, direction)
     desired = np.arctan2(direction[:, 1], direction[:, 0])
     turn = _wrap(desired - state.heading)
     # A held body keeps its whole pose (a turn swings the hips away from the stance feet just as a
@@ -650,7 +668,8 @@ def stage_steer(model: CrowdModel, state: CrowdState, boxes) -> None:
     # held to FLEE_GAIN_MAX of the asked one; avoiding, it walks only as far along its heading as the
     # avoiding velocity goes (sideways into a neighbour is no way out).
     unhindered = np.where(in_lane, np.minimum(goal_speed, FLEE_GAIN_MAX * state.desired_speed), state.desired_speed)
-    v_des = np.where(avoided, np.hypot(velocity[:, 0], velocity[:, 1]) * forward,
+    walked = np.where(retreat, np.maximum(along_now, 0.0), np.hypot(velocity[:, 0], velocity[:, 1]) * forward)
+    v_des = np.where(avoided, walked,
                      np.where(arrived, 0.0, unhindered * np.maximum(0.3, forward)))
     along = velocity[:, 0] * np.cos(state.heading) + velocity[:, 1] * np.sin(state.heading)
     v_des = np.where(backward, np.maximum(along, 0.0), v_des)
@@ -1898,8 +1917,8 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, fre
     # ahead of a body slowed on a hill, made robot5's front legs step twice a cycle (strides 40-60 %
     # off the law). A body turning on the spot does not walk toward them, nor does one near a moving
     # box: it turns away from the box, off the heading the foot is ahead along.
-    walking = state.speed >= 0.5 * sustained_speed(state)
-    walking &= ~moving_box_near(model, state, boxes)
+    at_pace = state.speed >= 0.5 * sustained_speed(state)
+    walking = at_pace & ~moving_box_near(model, state, boxes)
     dx, dz = state.feet[..., 0] - hips[..., 0], state.feet[..., 2] - hips[..., 2]
     ahead = walking[:, None] & (dx * np.cos(state.heading)[:, None] + dz * np.sin(state.heading)[:, None] > 0.0)
     far = (np.hypot(dx, dz) > _reach_xz(model)[None, :]) & ~ahead
@@ -1925,10 +1944,15 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, fre
     asked = np.maximum(np.minimum(state.goal_speed, state.speed_wanted), STEP_FOR_ASKED * state.goal_speed)[:, None]
     far |= cannot_follow | ((room <= 0.0) & (goal > 0.0)) | (leg_speed_caps(model, state, room, lift) < 0.5 * asked)
     # So does a stance foot that stops the body's turn (stance_turn_bounds: no room left), or holds the
-    # turn of a slow body under half the turn asked: a body turning on the spot turns by stepping.
+    # turn of a slow body under half the turn asked: a body turning on the spot turns by stepping. Slow by
+    # its speed alone: a body at its pace turns as its feet lift in their sectors, a moving box near or not.
+    # Counted slow near one (as `walking` is, for the reach above), a quadruped walking at 0.27 m/s beside
+    # a crate stepped its just-landed feet again a few frames later, strides 30-50 % short (crates-moving,
+    # seed 20019, character 5): 40 seeds of crates-moving and 20 of mixed, the quadrupeds' per-stride p90
+    # 0.143 -> 0.128 and 0.129 -> 0.093 (mean of the runs), the other creatures' runs unchanged.
     bound, wanted = leg_turn_bounds(model, state, lift), state.turn_wanted[:, None]
     holds_turn = (np.signbit(bound) == (wanted < 0.0)) & ~np.isnan(bound) & (wanted != 0.0)
-    stops_turn = holds_turn & ((bound == 0.0) | ((np.abs(bound) < 0.5 * np.abs(wanted)) & ~walking[:, None]))
+    stops_turn = holds_turn & ((bound == 0.0) | ((np.abs(bound) < 0.5 * np.abs(wanted)) & ~at_pace[:, None]))
     far |= stops_turn
     # Such a foot of a character escaping a moving box's lane that finds no footprint tucks (stage_plan),
     # as a threatened one does: held, it kept the body from turning out of the lane until the box came.

@@ -743,6 +743,47 @@ def test_a_character_with_a_neighbour_near_keeps_right_even_when_orca_has_nothin
                                [-KEEP_RIGHT, math.pi - KEEP_RIGHT], rtol=0, atol=1e-9)
 
 
+@pytest.mark.parametrize("kept, wanted", [
+    # ORCA's velocity 2.5 rad off the way (+x), at `kept` of the pace: the heading goes to the unit vectors'
+    # blend kept x (cos 2.5, sin 2.5) + (1 - kept) x (1, 0), by hand: 0.2 -> (0.6398, 0.1197), 0.18495 rad;
+    # 0.7 -> (-0.2608, 0.4189), 2.12762 rad; at the pace, to the velocity itself, 2.5 rad.
+    (0.2, 0.18495), (0.7, 2.12762), (1.0, 2.5)])
+def test_a_velocity_that_turns_back_from_the_way_turns_the_heading_by_the_share_of_the_pace_it_keeps(
+        monkeypatch, kept, wanted):
+    """A spider walking its way (+x) at its pace, ORCA's velocity 2.5 rad off it: a yield. Turned all the way
+    to a slow yielding velocity, a quadruped faced away from its way once its neighbour had passed and came
+    round again at its turn rate (crates-moving, seed 18102, character 4). It walks along its heading only as
+    far as the velocity goes: here, nowhere (the velocity points behind it)."""
+    import dataclasses
+
+    import footfall.planner._crowd as crowd
+    from footfall.planner._crowd import _boxes_now, stage_steer
+
+    scenario, creature = load_scenario("flat"), load_creature("spider")
+    model, state = init_crowd(scenario, creature, load_gait(default_gait_name("spider"), creature), n_characters=1,
+                              seed=0, lod_mode="off", raster=_raster(scenario, creature))
+    # A turn rate no frame bounds: the wanted turn is the whole turn to the heading asked.
+    model = dataclasses.replace(model, controller=dataclasses.replace(model.controller, turn_rate=1e3))
+    state.heading[:] = 0.0
+    state.route[0] = state.pelvis[0, [0, 2]] + [10.0, 0.0]
+    pace = float(state.desired_speed[0])
+    state.speed[:] = pace
+    yielding = kept * pace * np.array([[math.cos(2.5), math.sin(2.5)]])
+    seen = {}
+
+    def avoid(model, state, preferred, *rest):
+        seen["preferred"] = preferred.copy()
+        return yielding.copy(), np.ones(1, np.bool_), np.zeros(1, np.bool_), (np.zeros(2, np.int64),
+                                                                              np.zeros(0, np.int64))
+
+    monkeypatch.setattr(crowd, "_avoid", avoid)
+    monkeypatch.setattr(crowd, "wait_for_others", lambda *args: None)
+    stage_steer(model, state, _boxes_now(model, state.t))
+    np.testing.assert_allclose(seen["preferred"], [[pace, 0.0]], rtol=0, atol=1e-12)  # the premise: the way is +x
+    assert state.turn_wanted[0] == pytest.approx(wanted, abs=1e-4)
+    assert state.speed_wanted[0] == pytest.approx(0.0, abs=1e-12)
+
+
 def test_a_turn_is_bounded_by_the_stance_feet_nearest_the_midline():
     # A quadruped at heading 0 on its four feet, each at 0.3 m ahead of or behind the pelvis and
     # 0.15 m to its side, all lifting next frame: a turn of a swings a front foot 0.3 a sideways, so
@@ -859,8 +900,10 @@ def test_a_quadruped_turning_back_keeps_its_legs_uncrossed(monkeypatch):
 
 @pytest.mark.parametrize("creature_name, slack", [("spider", 1.1), ("ant", 1.1), ("robot5", 1.25), ("quadruped", 1.75)])
 def test_a_body_whose_way_lies_behind_it_comes_round_on_the_spot_at_its_turn_rate(monkeypatch, creature_name, slack):
-    # A character walking on flat ground is told by the avoidance to go straight back at 0.05 m/s: it
-    # walks none of that along its heading (a quarter turn or more away), so it turns on the spot. Its
+    # A character walking on flat ground finds its way behind it, and the avoidance tells it to go that way
+    # at 0.05 m/s: it walks none of that along its heading (a quarter turn or more away), so it turns on the
+    # spot. (With its way still ahead, such a velocity is a yield, which turns the heading only by the share
+    # of its pace it keeps: planner._crowd.stage_steer.) Its
     # needle runs at the tempo of the walk asked of it (planner._crowd.stage_gait, TURNING_FRACTION),
     # so its stance feet, lifted in turn, let it come round (to within 0.1 rad) in about the frames its
     # turn rate takes (61 at 1.5 rad/s): a spider or an ant in 1.1 x as many, a robot5 in 1.35 x, a
@@ -895,6 +938,7 @@ def test_a_body_whose_way_lies_behind_it_comes_round_on_the_spot_at_its_turn_rat
         for _ in range(int(np.random.default_rng(seed).integers(10, 61))):
             crowd.step(model, state)
         back = state.heading[0] + math.pi
+        state.route[0] = state.pelvis[0, [0, 2]] + 10.0 * np.array([math.cos(back), math.sin(back)])
         with monkeypatch.context() as patch:
             patch.setattr(crowd, "_avoid", avoiding_toward(0.05 * np.array([math.cos(back), math.sin(back)])))
             counters = FrameCounters(model, state)
@@ -1174,10 +1218,12 @@ def test_the_quadrupeds_coming_round_after_a_moving_velocity_walk_on():
     # crates-moving, 6 quadrupeds, seeds 4000 and 8008 (footfall evaluate's bar sets, 2026-11-28): at one
     # spot (-4.03, -2.17) character 4 turned on the spot after ORCA's velocity, which moved with the
     # right of way it was given and lost (north-east, north, west), at 0.6 rad/s and never walked: stuck
-    # 4.1 and 4.3 s. Stepping at its top walk's tempo it comes round and walks on.
+    # 4.1 and 4.3 s. Stepping at its top walk's tempo it comes round and walks on. Seed 18102 (a fresh bar set,
+    # 2026-12-02): character 4 yielding to character 2 turned after ORCA's slow retreating velocity, 3.4 rad
+    # away from its way and back (stuck 0.13 s); a yield now turns the heading by the share of the pace it keeps.
     from footfall.reports._evaluate import replay_command, run_one
 
-    for seed in (4000, 8008):
+    for seed in (4000, 8008, 18102):
         task = {"scenario": "crates-moving", "creature": "quadruped", "seed": seed, "characters": 6, "frames": 300,
                 "lod": "off"}
         run = run_one(task)

@@ -506,6 +506,47 @@ def test_a_swing_planned_on_a_lift_that_does_not_come_plans_again():
     assert kinds_next_frame(False)[0, leg] != KIND_REPLAN
 
 
+def test_a_stance_foot_that_slows_the_turn_of_a_body_at_its_pace_waits_for_its_sector_near_a_moving_box_too(
+        monkeypatch):
+    # A stance foot that bounds the turn asked to under half of it steps out of turn only for a slow body (it turns
+    # on the spot by stepping); a body at its pace turns as its feet lift in their sectors. Counted slow near a
+    # moving box as well, a quadruped walking at 0.27 m/s beside a crate stepped its just-landed feet again a few
+    # frames later: strides 30-50 % short, its run over the per-stride bar (crates-moving, seed 20019, character 5).
+    import copy
+
+    import footfall.planner._crowd as crowd
+    from footfall.planner.layout import KIND_FORCED_STEP, KIND_NONE
+    from footfall.scenarios import default_gait, load_scenario
+
+    quadruped = load_creature("quadruped")
+    model, state = crowd.init_crowd(load_scenario("flat"), quadruped, default_gait(quadruped), n_characters=1, seed=0)
+    for _ in range(60):
+        crowd.step(model, state)
+    while state.in_stance.sum() < 3:  # a leg to spare for a forced step
+        crowd.step(model, state)
+    foot = int(np.flatnonzero(state.in_stance[0])[0])
+    # Every stance foot allows 0.007 rad of the 0.026 rad turn asked (under half of it).
+    monkeypatch.setattr(crowd, "leg_turn_bounds", lambda m, s, lift=None: np.where(s.in_stance, -0.007, np.nan))
+
+    def kind(speed, crate_at):
+        s = copy.deepcopy(state)
+        s.speed[:] = speed
+        boxes = crowd._boxes_now(model, s.t)
+        if crate_at is not None:  # a moving crate crate_at m ahead of the pelvis
+            centre = s.pelvis[0] + [crate_at, 0.0, 0.0]
+            boxes = (centre[None], np.array([[0.4, 0.3, 0.4]]), np.zeros(1), np.ones(1, np.bool_), np.ones(1, np.bool_))
+            assert crowd.moving_box_near(model, s, boxes)[0]
+        frequency, enter, _ = crowd.stage_gait(model, s)
+        s.turn_wanted[:] = -0.026
+        return int(crowd.stage_requests(model, s, enter, boxes, crowd.hips_world(model, s), frequency)[0, foot])
+
+    pace = float(state.goal_speed[0])
+    assert kind(0.3 * pace, None) == KIND_FORCED_STEP
+    assert kind(0.3 * pace, 0.8) == KIND_FORCED_STEP
+    assert kind(pace, None) == KIND_NONE
+    assert kind(pace, 0.8) == KIND_NONE
+
+
 def test_neighbour_gaps_of_two_legs_by_hand():
     """Two legs on the left, hips at (0.01, 0.01) and (-0.01, 0.01), rest feet at (0.02, 0.05) and
     (-0.02, 0.05), windows of +-3 cm round them. Standing (no sweep): the feet 4 cm apart; the rear foot
