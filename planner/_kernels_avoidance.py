@@ -42,7 +42,8 @@ the other: a velocity behind a walker's heading, which it can only follow by tur
 that had met at a corner of their ways stood 1-3 s turning away from each other and back (crates-moving,
 quadrupeds, character 4 and its neighbour 2, in one run in ten). Measured 2026-12-02 with the heading rule
 for a velocity that turns back from the way (``planner._crowd.stage_steer``), on 100 fresh seeds of that
-scenario: failing runs 9 -> 4, stuck 12.7 -> 6.8 s, body overlaps 0 -> 0 (docs/crowds.md). Boxes are no discs
+scenario: failing runs 9 -> 4, stuck 12.7 -> 6.8 s, body overlaps 0 -> 0 (docs/crowds.md); with 0.1 / 0.5 s, 6 / 5
+failing runs and 8.7 / 7.0 s. Boxes are no discs
 round a body: a disc overlapping one is pushed out within a frame (parted within this time too, ten characters
 crowding a door came 1.7 cm into its walls: tests/test_avoidance.py)."""
 
