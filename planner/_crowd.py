@@ -2035,7 +2035,7 @@ def stage_requests(model: CrowdModel, state: CrowdState, enter, boxes, hips, fre
     # the foot plans again with that foot standing. Landed on the plan, a rear foot stood across its front
     # neighbour's leg, which lifted 10 frames late (a random 6-legged creature on `crates`).
     late_lift = np.zeros_like(swinging)
-    if state.counted_gone is not None:
+    if state.counted_gone is not None and at_neighbour_cap(model):  # (empty below the cap: stage_plan)
         stopped = _standing(state)[:, None] & state.in_stance
         late_lift = swinging & (state.counted_gone & (waited | stopped)[:, None, :]).any(axis=2)
     kinds[swinging & (((turned | sped | respaced) & ~landing) | invalid | state.tucked | state.shoved_onto_feet
@@ -2291,8 +2291,10 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
         drawn = rendered_joints(model, state, hips)
     drawn_rows, drawn_start = drawn_leg_segments(drawn, cs, oj, now)
     legs, legs_start = _with_neighbours_feet(model, state, cs, own, drawn_rows, drawn_start, preferred, support)
-    gone = np.zeros((f, 2 * oj.shape[1]), np.bool_)
-    if at_neighbour_cap(model):
+    # Only a crowd at its neighbour cap leaves feet out (lifted_before), and keeps which (counted_gone): below it
+    # the rooms have slack, and counted_gone stays empty.
+    leaves_out = at_neighbour_cap(model)
+    if leaves_out:
         gone = lifted_before(model, state, cs, oj, t_land) & (kinds[cs, ls] == KIND_NEW_SWING)[:, None]
         legs[_own_rows(legs_start, oj.shape[1])[gone], LEG_FOOT] = 0.0
     couples, slices, _ = budgets
@@ -2325,7 +2327,7 @@ def stage_plan(model: CrowdModel, state: CrowdState, kinds, frequency, budgets, 
                                      state.swing_T[cs, ls], ~ok & ~new & ~state.in_stance[cs, ls],
                                      state.foot_yaws[cs, ls])
     vc, vl = cs[ok], ls[ok]
-    if state.counted_gone is not None:
+    if leaves_out and state.counted_gone is not None:
         state.counted_gone[vc, vl] = False
         state.counted_gone[vc[:, None], vl[:, None], oj[ok]] = gone[ok, :oj.shape[1]]
     state.trajectories[vc, vl] = out.trajectory[ok]

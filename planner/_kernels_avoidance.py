@@ -11,10 +11,9 @@ avoid anyone: against a box A takes all of ``u``; the box is seen from A as its 
 nearest point is where a collision starts). A character already overlapping a box is pushed out
 within one time step, one overlapping a neighbour's disc within :data:`SEPARATION_S` (the discs are
 a margin round the bodies, which ``planner._crowd.bodies_apart`` keeps apart). A character that has
-waited too long for a neighbour to pass
-(the right of way, ``planner._crowd.wait_for_others``) leaves that neighbour's half-plane out, and the
-neighbour takes the whole effort: ORCA alone can hold a waiting character for seconds while a neighbour
-that steers round it orbits its disc.
+waited too long for a neighbour to pass (the right of way, ``planner._crowd.wait_for_others``) leaves
+that neighbour's half-plane out, and the neighbour takes the whole effort: ORCA alone can hold a waiting
+character for seconds while a neighbour that steers round it orbits its disc.
 
 The new velocity is the one closest to the preferred velocity inside every half-plane and the
 disc of the character's top speed: an incremental 2-D linear program; where the half-planes
@@ -42,10 +41,10 @@ the other: a velocity behind a walker's heading, which it can only follow by tur
 that had met at a corner of their ways stood 1-3 s turning away from each other and back (crates-moving,
 quadrupeds, character 4 and its neighbour 2, in one run in ten). Measured 2026-12-02 with the heading rule
 for a velocity that turns back from the way (``planner._crowd.stage_steer``), on 100 fresh seeds of that
-scenario: failing runs 9 -> 4, stuck 12.7 -> 6.8 s, body overlaps 0 -> 0 (docs/crowds.md); with 0.1 / 0.5 s, 6 / 5
-failing runs and 8.7 / 7.0 s. Boxes are no discs
-round a body: a disc overlapping one is pushed out within a frame (parted within this time too, ten characters
-crowding a door came 1.7 cm into its walls: tests/test_avoidance.py)."""
+scenario: failing runs 9 -> 4, stuck 12.7 -> 6.8 s, body overlaps 0 -> 0 (docs/crowds.md); with 0.1 / 0.5 s,
+6 / 5 failing runs and 8.7 / 7.0 s. Boxes are no discs round a body: a disc overlapping one is pushed out
+within a frame (parted within this time too, ten characters crowding a door came 1.7 cm into its walls:
+tests/test_avoidance.py)."""
 
 
 @nb.njit(cache=True)
